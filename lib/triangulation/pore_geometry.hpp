@@ -1,0 +1,78 @@
+// Pore geometry of the regular triangulation: cells (pores) and facets (throats).
+//
+// Walls are treated in the limit of an infinite fictitious radius. A wall vertex is then a
+// direction (-n, out of the box) rather than a point: a cell with wall vertices is the prism
+// swept from its sphere centres towards the walls, and its power centre lies on the wall
+// planes. This is the thesis' "prismatic" boundary pore (section 2.3 of the spec) made exact,
+// and it avoids the cancellation of R^2-sized terms that a finite huge sphere would cause.
+//
+// Per cell: total volume, fluid volume, power centre. Per facet: area vector, fluid area,
+// hydraulic radius R_h = phi/gamma, length L between power centres, the sphere sectors A^k
+// and wetted areas gamma^k of its three vertices (walls included only for no-slip).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "box_walls.hpp"
+#include "mesh.hpp"
+#include "vec3.hpp"
+
+namespace pfv {
+
+// A cell's vertices with spheres first, then walls (as wall indices 0..5).
+struct CellShape {
+  std::int8_t n_walls = 0;
+  std::array<int, 4> v{};  // v[0..3-n_walls] sphere ids, the rest wall indices
+};
+
+struct CellGeometry {
+  std::vector<CellShape> shape;
+  std::vector<double> volume;        // total (tetrahedron or wall prism)
+  std::vector<double> fluid_volume;  // volume minus sphere sectors, floored at 0
+  std::vector<Vec3> power_centre;
+};
+
+struct FacetGeometry {
+  // Facet f separates cell[f][0] from cell[f][1] (-1: no pore cell on that side) and is
+  // the facet opposite local vertex local[f][0] of cell[f][0].
+  std::vector<std::array<int, 2>> cell;
+  std::vector<std::array<int, 2>> local;
+  std::vector<std::array<int, 3>> vertex;  // mesh vertex ids (walls: n_spheres + w)
+  std::vector<Vec3> area_vector;           // |S| times the unit normal from cell 0 to cell 1
+  std::vector<double> fluid_area;
+  std::vector<double> length;              // |P_0 P_1|; 0 for a one-sided facet
+  std::vector<double> hydraulic_radius;
+  std::vector<std::array<double, 3>> sector_area;  // A^k
+  std::vector<std::array<double, 3>> wetted_area;  // gamma^k
+
+  int size() const { return static_cast<int>(cell.size()); }
+};
+
+struct Packing {
+  const std::vector<Vec3>& centre;
+  const std::vector<double>& radius;
+  const BoxWalls& walls;
+};
+
+CellShape make_cell_shape(const Mesh& mesh, int cell);
+
+// Total volume of a cell for the current positions; this is what dV/dt differentiates.
+double cell_volume(const CellShape& s, const std::vector<Vec3>& centre, const BoxWalls& walls);
+
+CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& packing);
+
+FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells,
+                                     const Packing& packing, bool slip_boundary);
+
+// Projected area of a cell on each of its walls, as outward force vectors per unit
+// pressure (the wall part of the force cache). Entry k is for local vertex k of the cell;
+// sphere vertices get zero.
+std::array<Vec3, 4> wall_footprints(const Mesh& mesh, int cell, const Packing& packing);
+
+// The polygon of a facet (triangle, wall trapezoid or wall rectangle) as an area vector
+// oriented away from the vertex 'opposite' of the owning cell.
+Vec3 facet_area_vector(const Mesh& mesh, const std::array<int, 3>& facet, int opposite,
+                       const Packing& packing);
+
+}  // namespace pfv

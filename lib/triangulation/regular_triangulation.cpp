@@ -1,0 +1,130 @@
+#include "regular_triangulation.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_3.h>
+#include <CGAL/Regular_triangulation_cell_base_3.h>
+#include <CGAL/Regular_triangulation_vertex_base_3.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <utility>
+
+namespace pfv {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, CGAL::Regular_triangulation_vertex_base_3<K>>;
+// Hidden points are not needed (they are reported from vertex info), so do not store them.
+using Cb = CGAL::Triangulation_cell_base_with_info_3<
+    int, K,
+    CGAL::Regular_triangulation_cell_base_3<K, CGAL::Triangulation_cell_base_3<K>,
+                                            CGAL::Discard_hidden_points>>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
+using RT = CGAL::Regular_triangulation_3<K, Tds>;
+using WPoint = RT::Weighted_point;
+
+}  // namespace
+
+struct RegularTriangulation::Impl {
+  RT rt;
+};
+
+RegularTriangulation::RegularTriangulation() : impl_(std::make_unique<Impl>()) {}
+RegularTriangulation::~RegularTriangulation() = default;
+RegularTriangulation::RegularTriangulation(RegularTriangulation&&) noexcept = default;
+RegularTriangulation& RegularTriangulation::operator=(RegularTriangulation&&) noexcept = default;
+
+const Mesh& RegularTriangulation::build(const std::vector<Vec3>& centres,
+                                        const std::vector<double>& radii, const BoxWalls& walls) {
+  const int n = static_cast<int>(centres.size());
+  RT& rt = impl_->rt;
+  rt.clear();
+
+  Vec3 mid;
+  double size = 0;
+  for (int a = 0; a < 3; ++a) {
+    mid[a] = 0.5 * (walls.coord[2 * a] + walls.coord[2 * a + 1]);
+    size = std::max(size, walls.extent(a));
+  }
+  const double big = kWallRadiusFactor * size;
+
+  std::vector<std::pair<WPoint, int>> points;
+  points.reserve(n + kWallCount);
+  for (int k = 0; k < n; ++k)
+    points.emplace_back(WPoint(K::Point_3(centres[k].x(), centres[k].y(), centres[k].z()),
+                               radii[k] * radii[k]),
+                        k);
+  for (int w = 0; w < kWallCount; ++w) {
+    Vec3 c = mid;
+    c[wall_axis(w)] = walls.coord[w];
+    c -= big * walls.inward_normal(w);
+    points.emplace_back(WPoint(K::Point_3(c.x(), c.y(), c.z()), big * big), n + w);
+  }
+  rt.insert(points.begin(), points.end());  // spatially sorted bulk insertion
+
+  mesh_ = Mesh{};
+  mesh_.n_spheres = n;
+  std::vector<char> present(n, 0);
+  for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v)
+    if (v->info() < n) present[v->info()] = 1;
+  for (int k = 0; k < n; ++k)
+    if (!present[k]) mesh_.hidden_spheres.push_back(k);
+
+  // Keep cells with a sphere vertex and no pair of opposite walls; number them.
+  int count = 0;
+  for (auto c = rt.all_cells_begin(); c != rt.all_cells_end(); ++c) {
+    c->info() = -1;
+    if (rt.is_infinite(c)) continue;
+    int spheres = 0, wall_mask = 0;
+    bool opposite = false;
+    for (int i = 0; i < 4; ++i) {
+      const int v = c->vertex(i)->info();
+      if (v < n) {
+        ++spheres;
+      } else {
+        const int w = v - n;
+        if (wall_mask & (1 << (w ^ 1))) opposite = true;
+        wall_mask |= 1 << w;
+      }
+    }
+    if (spheres == 0 || opposite) continue;
+    c->info() = count++;
+  }
+  mesh_.cell_vertices.resize(count);
+  mesh_.cell_neighbours.resize(count);
+  for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c) {
+    const int id = c->info();
+    if (id < 0) continue;
+    for (int i = 0; i < 4; ++i) {
+      mesh_.cell_vertices[id][i] = c->vertex(i)->info();
+      mesh_.cell_neighbours[id][i] = c->neighbor(i)->info();
+    }
+  }
+  return mesh_;
+}
+
+int RegularTriangulation::locate(const Vec3& x) const {
+  const RT& rt = impl_->rt;
+  if (rt.dimension() < 3) return -1;
+  const auto c = rt.locate(WPoint(K::Point_3(x.x(), x.y(), x.z()), 0.0));
+  if (rt.is_infinite(c)) return -1;
+  return c->info();
+}
+
+std::vector<std::pair<int, int>> RegularTriangulation::centres_inside_neighbours(
+    const std::vector<Vec3>& centres, const std::vector<double>& radii) const {
+  std::vector<std::pair<int, int>> bad;
+  const RT& rt = impl_->rt;
+  const int n = mesh_.n_spheres;
+  for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e) {
+    const int a = e->first->vertex(e->second)->info();
+    const int b = e->first->vertex(e->third)->info();
+    if (a >= n || b >= n) continue;
+    const double d = (centres[a] - centres[b]).norm();
+    if (d < std::max(radii[a], radii[b])) bad.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  return bad;
+}
+
+}  // namespace pfv

@@ -1,0 +1,47 @@
+// Regular (weighted Delaunay) triangulation of a sphere packing inside six walls.
+//
+// Weights are squared radii; each wall enters as a fictitious sphere whose radius is
+// kWallRadiusFactor times the box size and whose surface lies on the wall plane. CGAL
+// decides the combinatorics with exact predicates; nothing geometric is taken from CGAL
+// afterwards (see pore_geometry.hpp for why the walls are treated as planes there).
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "box_walls.hpp"
+#include "mesh.hpp"
+#include "vec3.hpp"
+
+namespace pfv {
+
+class RegularTriangulation {
+ public:
+  static constexpr double kWallRadiusFactor = 1e6;  // thesis, section 3.5 (R = 1e6 l0)
+
+  RegularTriangulation();
+  ~RegularTriangulation();
+  RegularTriangulation(RegularTriangulation&&) noexcept;
+  RegularTriangulation& operator=(RegularTriangulation&&) noexcept;
+  RegularTriangulation(const RegularTriangulation&) = delete;
+  RegularTriangulation& operator=(const RegularTriangulation&) = delete;
+
+  // Rebuilds from scratch (bulk insertion with spatial sorting) and returns the pore mesh.
+  const Mesh& build(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                    const BoxWalls& walls);
+
+  const Mesh& mesh() const { return mesh_; }
+
+  // Index of the pore cell containing x, or -1 if x lies in no pore cell.
+  int locate(const Vec3& x) const;
+
+  // Pairs of spheres joined by an edge with one centre inside the other sphere.
+  std::vector<std::pair<int, int>> centres_inside_neighbours(
+      const std::vector<Vec3>& centres, const std::vector<double>& radii) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Mesh mesh_;
+};
+
+}  // namespace pfv

@@ -1,0 +1,7 @@
+// Small vector vocabulary shared by the triangulation and the flow model.
+#pragma once
+#include <Eigen/Core>
+
+namespace pfv {
+using Vec3 = Eigen::Vector3d;
+}  // namespace pfv

@@ -1,0 +1,111 @@
+#include "cholmod_solver.hpp"
+
+#include <suitesparse/cholmod.h>
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "pressure_system.hpp"
+
+namespace pfv {
+
+struct CholmodSolver::Common {
+  cholmod_common c;
+};
+
+CholmodSolver::CholmodSolver() : common_(new Common) {
+  cholmod_start(&common_->c);
+  common_->c.supernodal = CHOLMOD_SUPERNODAL;
+  common_->c.print = 0;
+}
+
+CholmodSolver::~CholmodSolver() {
+  release();
+  cholmod_finish(&common_->c);
+  delete common_;
+}
+
+void CholmodSolver::release() {
+  cholmod_common* c = &common_->c;
+  if (factor_) {
+    auto* f = static_cast<cholmod_factor*>(factor_);
+    cholmod_free_factor(&f, c);
+  }
+  for (void** d : {&rhs_, &x_, &work_y_, &work_e_})
+    if (*d) {
+      auto* m = static_cast<cholmod_dense*>(*d);
+      cholmod_free_dense(&m, c);
+      *d = nullptr;
+    }
+  factor_ = nullptr;
+}
+
+double CholmodSolver::factor_nonzeros() const {
+  return factor_ ? common_->c.lnz : 0.0;
+}
+
+void CholmodSolver::factorize(const PressureSystem& s, bool force_metis) {
+  release();
+  cholmod_common* c = &common_->c;
+  const int n = s.n_unknowns();
+  if (n == 0) return;
+  if (force_metis) {
+    c->nmethods = 1;
+    c->method[0].ordering = CHOLMOD_METIS;
+    c->postorder = 1;
+  } else {
+    c->nmethods = 0;  // CHOLMOD's default: AMD, then METIS if AMD fills badly
+  }
+  // A view of the assembled arrays; CHOLMOD only reads them.
+  cholmod_sparse a{};
+  a.nrow = a.ncol = n;
+  a.nzmax = s.value.size();
+  a.p = const_cast<int*>(s.col_start.data());
+  a.i = const_cast<int*>(s.row.data());
+  a.x = const_cast<double*>(s.value.data());
+  a.stype = 1;  // upper triangle stored
+  a.itype = CHOLMOD_INT;
+  a.xtype = CHOLMOD_REAL;
+  a.dtype = CHOLMOD_DOUBLE;
+  a.sorted = 1;
+  a.packed = 1;
+
+  cholmod_factor* f = cholmod_analyze(&a, c);
+  if (!f) throw std::runtime_error("CHOLMOD analysis failed (status " + std::to_string(c->status) + ")");
+  factor_ = f;
+  metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS;
+  cholmod_factorize(&a, f, c);
+  if (c->status == CHOLMOD_NOT_POSDEF || f->minor < static_cast<size_t>(n)) {
+    const auto minor = f->minor;
+    release();
+    throw std::domain_error("singular pressure system: the conductance matrix is not positive definite "
+                            "(pivot " + std::to_string(minor) + " of " + std::to_string(n) + ")");
+  }
+  if (c->status < CHOLMOD_OK) {
+    release();
+    throw std::runtime_error("CHOLMOD factorisation failed (status " + std::to_string(c->status) + ")");
+  }
+  rhs_ = cholmod_zeros(n, 1, CHOLMOD_REAL, c);
+}
+
+void CholmodSolver::solve(const std::vector<double>& rhs, std::vector<double>& x) {
+  if (!factor_) {
+    x.clear();
+    return;
+  }
+  cholmod_common* c = &common_->c;
+  auto* b = static_cast<cholmod_dense*>(rhs_);
+  std::memcpy(b->x, rhs.data(), rhs.size() * sizeof(double));
+  auto* xd = static_cast<cholmod_dense*>(x_);
+  auto* y = static_cast<cholmod_dense*>(work_y_);
+  auto* e = static_cast<cholmod_dense*>(work_e_);
+  // cholmod_solve2 allocates x, y, e on the first call and reuses them afterwards.
+  cholmod_solve2(CHOLMOD_A, static_cast<cholmod_factor*>(factor_), b, nullptr, &xd, nullptr, &y, &e, c);
+  x_ = xd;
+  work_y_ = y;
+  work_e_ = e;
+  x.assign(static_cast<double*>(xd->x), static_cast<double*>(xd->x) + rhs.size());
+}
+
+}  // namespace pfv

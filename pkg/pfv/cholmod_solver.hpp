@@ -1,0 +1,37 @@
+// Sparse Cholesky of G with CHOLMOD: analysed and factorised once per remesh, then only
+// forward/back substitution each step, into buffers allocated at factorisation.
+// Owns every CHOLMOD object it creates (YADE leaked factors here).
+#pragma once
+#include <vector>
+
+namespace pfv {
+
+struct PressureSystem;
+
+class CholmodSolver {
+ public:
+  CholmodSolver();
+  ~CholmodSolver();
+  CholmodSolver(const CholmodSolver&) = delete;
+  CholmodSolver& operator=(const CholmodSolver&) = delete;
+
+  // Throws std::domain_error if G is not positive definite.
+  void factorize(const PressureSystem& system, bool force_metis);
+  void solve(const std::vector<double>& rhs, std::vector<double>& x);
+  bool metis_used() const { return metis_used_; }
+  bool ready() const { return factor_ != nullptr; }
+  double factor_nonzeros() const;
+
+ private:
+  void release();
+  struct Common;
+  Common* common_;
+  void* factor_ = nullptr;  // cholmod_factor*
+  void* rhs_ = nullptr;     // cholmod_dense*, reused
+  void* x_ = nullptr;
+  void* work_y_ = nullptr;
+  void* work_e_ = nullptr;
+  bool metis_used_ = false;
+};
+
+}  // namespace pfv

@@ -1,0 +1,43 @@
+// The linear system G p = -dV/dt + Q_q + Q_p over the pore cells (thesis 3.5).
+//
+// Cells touching a pressure wall, or holding an imposed pressure, are Dirichlet cells and
+// drop out of the unknowns; their pressures enter the right-hand side. G is symmetric
+// positive definite once every group of connected unknown cells reaches a Dirichlet cell;
+// assembly checks this and names the problem otherwise.
+#pragma once
+#include <vector>
+
+#include "boundary_conditions.hpp"
+#include "mesh.hpp"
+#include "pore_geometry.hpp"
+
+namespace pfv {
+
+struct PressureSystem {
+  // Per cell.
+  std::vector<int> unknown;  // index among unknowns, -1 for a Dirichlet cell
+  std::vector<int> source;   // Dirichlet source: wall w, or kWallCount + imposed point; else -1
+  std::vector<double> diagonal;  // sum of k over the cell's throats
+  // Cell adjacency through throats, both directions (CSR).
+  std::vector<int> adj_start, adj_cell;
+  std::vector<double> adj_k;
+  // Unknowns.
+  std::vector<int> unknown_cell;
+  // Upper triangle of G over the unknowns, compressed by column (row <= column).
+  std::vector<int> col_start, row;
+  std::vector<double> value;
+
+  int n_unknowns() const { return static_cast<int>(unknown_cell.size()); }
+};
+
+// imposed_cells[k] is the cell of bc.imposed_pressure[k] (-1 if it lies in no cell).
+PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets,
+                                        const std::vector<double>& k,
+                                        const BoundaryConditions& bc,
+                                        const std::vector<int>& imposed_cells);
+
+// Pressures of the Dirichlet cells from the current boundary values (cheap; every step).
+void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc,
+                            std::vector<double>& pressure);
+
+}  // namespace pfv

@@ -1,0 +1,210 @@
+// pybind11 bindings of the C++ engine (module pfv._core). Arrays cross as numpy buffers;
+// YADE's attribute names live in the Python layer (pfv/flow_engine.py), not here.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "flow_engine.hpp"
+
+namespace py = pybind11;
+using namespace pfv;
+
+namespace {
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+std::vector<Vec3> to_points(const Array& a, const char* name) {
+  if (a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(std::string(name) + " must have shape (n, 3)");
+  std::vector<Vec3> out(a.shape(0));
+  static_assert(sizeof(Vec3) == 3 * sizeof(double));
+  if (!out.empty()) std::memcpy(static_cast<void*>(out.data()), a.data(), out.size() * sizeof(Vec3));
+  return out;
+}
+
+std::vector<double> to_vector(const Array& a, const char* name) {
+  if (a.ndim() != 1) throw py::value_error(std::string(name) + " must be one-dimensional");
+  return std::vector<double>(a.data(), a.data() + a.shape(0));
+}
+
+Array points_to_array(const std::vector<Vec3>& v) {
+  Array out({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
+  if (!v.empty()) std::memcpy(out.mutable_data(), v.data(), v.size() * sizeof(Vec3));
+  return out;
+}
+
+template <class T>
+py::array_t<T> vector_to_array(const std::vector<T>& v) {
+  return py::array_t<T>(static_cast<py::ssize_t>(v.size()), v.data());
+}
+
+BoxWalls to_walls(const std::array<double, 6>& w) {
+  BoxWalls b;
+  b.coord = w;
+  return b;
+}
+
+py::dict times_dict(const StageTimes& t) {
+  py::dict d;
+  d["triangulation"] = t.triangulation;
+  d["geometry"] = t.geometry;
+  d["conductance"] = t.conductance;
+  d["assembly"] = t.assembly;
+  d["factorization"] = t.factorization;
+  d["force_cache"] = t.force_cache;
+  d["volumes"] = t.volumes;
+  d["solve"] = t.solve;
+  d["forces"] = t.forces;
+  return d;
+}
+
+void check_cell(const FlowEngine& e, int id) {
+  if (id < 0 || id >= e.mesh().n_cells()) throw py::index_error("no pore cell with index " + std::to_string(id));
+}
+
+void check_wall(int w) {
+  if (w < 0 || w >= kWallCount) throw py::index_error("wall index must be in 0..5");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "PFV pore-scale flow engine (C++ core)";
+  m.def("set_num_threads", [](int n) {
+#ifdef _OPENMP
+    omp_set_num_threads(std::max(1, n));
+#endif
+  });
+  m.def("get_max_threads", []() {
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+  });
+
+  py::class_<FlowEngine>(m, "Engine")
+      .def(py::init<>())
+      // Settings.
+      .def_property("viscosity", [](const FlowEngine& e) { return e.settings.conductance.viscosity; },
+                    [](FlowEngine& e, double v) {
+                      if (!(v > 0 && std::isfinite(v))) throw py::value_error("viscosity must be positive and finite");
+                      e.settings.conductance.viscosity = v;
+                    })
+      .def_property("permeability_factor", [](const FlowEngine& e) { return e.settings.conductance.permeability_factor; },
+                    [](FlowEngine& e, double v) {
+                      if (!(v > 0 && std::isfinite(v)))
+                        throw py::value_error("permeabilityFactor must be positive (the negative 'homogeneous' variant is not supported)");
+                      e.settings.conductance.permeability_factor = v;
+                      e.request_remesh();
+                    })
+      .def_property("clamp_k_values", [](const FlowEngine& e) { return e.settings.conductance.clamp; },
+                    [](FlowEngine& e, bool v) { e.settings.conductance.clamp = v; e.request_remesh(); })
+      .def_property("min_k_div_k_mean", [](const FlowEngine& e) { return e.settings.conductance.min_ratio; },
+                    [](FlowEngine& e, double v) { e.settings.conductance.min_ratio = v; e.request_remesh(); })
+      .def_property("max_k_div_k_mean", [](const FlowEngine& e) { return e.settings.conductance.max_ratio; },
+                    [](FlowEngine& e, double v) { e.settings.conductance.max_ratio = v; e.request_remesh(); })
+      .def_property("slip_boundary", [](const FlowEngine& e) { return e.settings.slip_boundary; },
+                    [](FlowEngine& e, bool v) { e.settings.slip_boundary = v; e.request_remesh(); })
+      .def_property("use_solver", [](const FlowEngine& e) { return e.settings.use_solver; },
+                    [](FlowEngine& e, int v) {
+                      if (v != 0 && v != 3) throw py::value_error("useSolver must be 0 (Gauss-Seidel) or 3 (CHOLMOD)");
+                      e.settings.use_solver = v;
+                    })
+      .def_property("tolerance", [](const FlowEngine& e) { return e.settings.tolerance; },
+                    [](FlowEngine& e, double v) { e.settings.tolerance = v; })
+      .def_property("relax", [](const FlowEngine& e) { return e.settings.relax; },
+                    [](FlowEngine& e, double v) {
+                      if (!(v > 0 && v < 2)) throw py::value_error("relax must be in (0, 2)");
+                      e.settings.relax = v;
+                    })
+      .def_property("max_gs_iterations", [](const FlowEngine& e) { return e.settings.max_gs_iterations; },
+                    [](FlowEngine& e, int v) { e.settings.max_gs_iterations = v; })
+      .def_property("force_metis", [](const FlowEngine& e) { return e.settings.force_metis; },
+                    [](FlowEngine& e, bool v) { e.settings.force_metis = v; e.request_bc_update(); })
+      .def_property("mesh_update_interval", [](const FlowEngine& e) { return e.settings.mesh_update_interval; },
+                    [](FlowEngine& e, int v) { e.settings.mesh_update_interval = v; })
+      .def_property("def_tolerance", [](const FlowEngine& e) { return e.settings.def_tolerance; },
+                    [](FlowEngine& e, double v) { e.settings.def_tolerance = v; })
+      .def_property("p_zero", [](const FlowEngine& e) { return e.settings.p_zero; },
+                    [](FlowEngine& e, double v) { e.settings.p_zero = v; })
+      // Boundary conditions.
+      .def_property("bnd_is_pressure", [](const FlowEngine& e) { return e.bc.is_pressure; },
+                    [](FlowEngine& e, const std::array<bool, 6>& v) {
+                      if (v != e.bc.is_pressure) e.request_bc_update();
+                      e.bc.is_pressure = v;
+                    })
+      .def_property("bnd_value", [](const FlowEngine& e) { return e.bc.value; },
+                    [](FlowEngine& e, const std::array<double, 6>& v) { e.bc.value = v; })
+      .def("impose_pressure", [](FlowEngine& e, const std::array<double, 3>& x, double p) {
+             e.bc.imposed_pressure.push_back({Vec3(x[0], x[1], x[2]), p});
+             e.request_bc_update();
+             return static_cast<int>(e.bc.imposed_pressure.size()) - 1;
+           })
+      .def("set_imposed_pressure", [](FlowEngine& e, int i, double p) {
+             if (i < 0 || i >= static_cast<int>(e.bc.imposed_pressure.size()))
+               throw py::index_error("no imposed pressure with index " + std::to_string(i));
+             e.bc.imposed_pressure[i].value = p;
+           })
+      .def("clear_imposed_pressure", [](FlowEngine& e) { e.bc.imposed_pressure.clear(); e.request_bc_update(); })
+      .def("impose_flux", [](FlowEngine& e, const std::array<double, 3>& x, double q) {
+             e.bc.imposed_flux.push_back({Vec3(x[0], x[1], x[2]), q});
+             e.request_bc_update();
+             return static_cast<int>(e.bc.imposed_flux.size()) - 1;
+           })
+      .def("clear_imposed_flux", [](FlowEngine& e) { e.bc.imposed_flux.clear(); e.request_bc_update(); })
+      .def("request_remesh", &FlowEngine::request_remesh)
+      .def("request_bc_update", &FlowEngine::request_bc_update)
+      .def("remesh_due", &FlowEngine::remesh_due)
+      .def("has_mesh", &FlowEngine::has_mesh)
+      // The step.
+      .def("step", [](FlowEngine& e, const Array& centres, const Array& radii, const std::array<double, 6>& walls, double dt) {
+             auto c = to_points(centres, "positions");
+             auto r = to_vector(radii, "radii");
+             const BoxWalls w = to_walls(walls);
+             py::gil_scoped_release release;
+             e.step(c, r, w, dt);
+           }, py::arg("positions"), py::arg("radii"), py::arg("walls"), py::arg("dt"))
+      .def("forces", [](const FlowEngine& e) { return points_to_array(e.forces()); },
+           "Fluid force on every sphere (input order), then on the six walls.")
+      .def("pressure", [](const FlowEngine& e) { return vector_to_array(e.pressure()); })
+      // Queries.
+      .def("n_cells", [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().n_cells() : 0; })
+      .def("boundary_flux", [](const FlowEngine& e, int w) { check_wall(w); return e.boundary_flux(w); })
+      .def("imposed_flux_total", &FlowEngine::imposed_flux_total)
+      .def("volume_rate_total", &FlowEngine::volume_rate_total)
+      .def("average_pressure", &FlowEngine::average_pressure)
+      .def("average_slice_pressure", &FlowEngine::average_slice_pressure)
+      .def("locate", [](const FlowEngine& e, const std::array<double, 3>& x) { return e.locate(Vec3(x[0], x[1], x[2])); })
+      .def("cell_pressure", [](const FlowEngine& e, int id) { check_cell(e, id); return e.pressure()[id]; })
+      .def("cell_center", [](const FlowEngine& e, int id) {
+             check_cell(e, id);
+             const Vec3& c = e.cells().power_centre[id];
+             return std::array<double, 3>{c.x(), c.y(), c.z()};
+           })
+      .def("cell_volume", [](const FlowEngine& e, int id) { check_cell(e, id); return e.cells().volume[id]; })
+      .def("cell_fluid_volume", [](const FlowEngine& e, int id) { check_cell(e, id); return e.cells().fluid_volume[id]; })
+      .def("metis_used", &FlowEngine::metis_used)
+      .def("hidden_spheres", [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; })
+      .def_property_readonly("remesh_count", &FlowEngine::remesh_count)
+      .def_property_readonly("gs_iterations", &FlowEngine::gs_iterations)
+      .def("walls", [](const FlowEngine& e) { return e.walls().coord; })
+      .def("remesh_times", [](const FlowEngine& e) { return times_dict(e.remesh_times()); })
+      .def("step_times", [](const FlowEngine& e) { return times_dict(e.step_times()); })
+      // Geometry, for tests and post-processing.
+      .def("cell_vertices", [](const FlowEngine& e) {
+             const auto& cv = e.mesh().cell_vertices;
+             py::array_t<int> out({static_cast<py::ssize_t>(cv.size()), py::ssize_t{4}});
+             if (!cv.empty()) std::memcpy(out.mutable_data(), cv.data(), cv.size() * sizeof(cv[0]));
+             return out;
+           })
+      .def("cell_volumes", [](const FlowEngine& e) { return vector_to_array(e.cells().volume); })
+      .def("cell_fluid_volumes", [](const FlowEngine& e) { return vector_to_array(e.cells().fluid_volume); })
+      .def("cell_centers", [](const FlowEngine& e) { return points_to_array(e.cells().power_centre); })
+      .def("conductances", [](const FlowEngine& e) { return vector_to_array(e.conductances()); })
+      .def("facet_cells", [](const FlowEngine& e) { return e.facets().cell; });
+}

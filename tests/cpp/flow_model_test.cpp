@@ -1,0 +1,178 @@
+// The flow model end to end on fixed packings: conductance law, solvers, conservation,
+// force balance and the invariances the thesis states.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "conductance.hpp"
+#include "flow_engine.hpp"
+#include "test_packings.hpp"
+
+using namespace pfv;
+
+namespace {
+
+FlowEngine permeameter(int axis = 0, double p_in = 1.0) {
+  FlowEngine e;
+  e.bc.is_pressure[2 * axis] = e.bc.is_pressure[2 * axis + 1] = true;
+  e.bc.value[2 * axis] = p_in;
+  return e;
+}
+
+}  // namespace
+
+TEST(Conductance, PoiseuilleForACircularTube) {
+  // A throat with R_h = r/2 and A = pi r^2 must carry pi r^4 / (8 mu L).
+  FacetGeometry f;
+  const double r = 0.3, mu = 2.5, L = 1.7;
+  f.cell = {{0, 1}};
+  f.fluid_area = {M_PI * r * r};
+  f.hydraulic_radius = {r / 2};
+  f.length = {L};
+  ConductanceModel m;
+  m.viscosity = mu;
+  m.clamp = false;
+  EXPECT_NEAR(throat_conductances(f, m)[0], M_PI * std::pow(r, 4) / (8 * mu * L), 1e-15);
+}
+
+TEST(FlowModel, CholmodMatchesDenseSolve) {
+  const auto p = test::random_packing(200, 21);
+  FlowEngine e = permeameter(1);
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  const PressureSystem& s = e.system();
+  const int n = s.n_unknowns();
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+  for (int col = 0; col < n; ++col)
+    for (int q = s.col_start[col]; q < s.col_start[col + 1]; ++q) G(s.row[q], col) = G(col, s.row[q]) = s.value[q];
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+  for (int u = 0; u < n; ++u) {
+    const int c = s.unknown_cell[u];
+    for (int a = s.adj_start[c]; a < s.adj_start[c + 1]; ++a)
+      if (s.unknown[s.adj_cell[a]] < 0) b[u] += s.adj_k[a] * e.pressure()[s.adj_cell[a]];
+  }
+  const Eigen::VectorXd x = G.ldlt().solve(b);
+  for (int u = 0; u < n; ++u) EXPECT_NEAR(e.pressure()[s.unknown_cell[u]], x[u], 1e-10);
+}
+
+TEST(FlowModel, GaussSeidelConvergesToTheDirectSolution) {
+  const auto p = test::random_packing(200, 22);
+  FlowEngine direct = permeameter(0), gs = permeameter(0);
+  gs.settings.use_solver = 0;
+  gs.settings.tolerance = 1e-10;
+  direct.step(p.centre, p.radius, p.walls, 1.0);
+  gs.step(p.centre, p.radius, p.walls, 1.0);
+  EXPECT_GT(gs.gs_iterations(), 1);
+  for (std::size_t c = 0; c < direct.pressure().size(); ++c) EXPECT_NEAR(gs.pressure()[c], direct.pressure()[c], 1e-7);
+}
+
+TEST(FlowModel, InflowEqualsOutflow) {
+  const auto p = test::random_packing(300, 23);
+  for (int axis = 0; axis < 3; ++axis) {
+    FlowEngine e = permeameter(axis);
+    e.step(p.centre, p.radius, p.walls, 1.0);
+    const double qin = e.boundary_flux(2 * axis), qout = e.boundary_flux(2 * axis + 1);
+    EXPECT_LT(qin, 0);  // YADE's sign: inflow negative
+    EXPECT_GT(qout, 0);
+    EXPECT_LE(std::abs(qin + qout), 1e-8 * std::abs(qin));
+  }
+}
+
+TEST(FlowModel, TotalForceOnSolidsIsPressureDropTimesArea) {
+  const auto p = test::random_packing(300, 24);
+  const double dp = 3.0;
+  FlowEngine e = permeameter(2, dp);
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  const auto& F = e.forces();
+  const int n = static_cast<int>(p.centre.size());
+  Vec3 solid = Vec3::Zero();  // spheres plus the no-flux (lateral) walls
+  for (int k = 0; k < n; ++k) solid += F[k];
+  for (int w = 0; w < 4; ++w) solid += F[n + w];
+  EXPECT_NEAR(solid.z(), dp * 1.0, 1e-7 * dp);
+  EXPECT_NEAR(solid.x(), 0.0, 1e-10);
+  EXPECT_NEAR(solid.y(), 0.0, 1e-10);
+  // And the spheres alone carry the drop in the flow direction (lateral walls only push sideways).
+  Vec3 spheres = Vec3::Zero();
+  for (int k = 0; k < n; ++k) spheres += F[k];
+  EXPECT_NEAR(spheres.z(), dp, 1e-7 * dp);
+}
+
+TEST(FlowModel, UniformPressureGivesNoNetForceOnSpheres) {
+  const auto p = test::random_packing(250, 25);
+  FlowEngine e;
+  e.bc.is_pressure.fill(true);
+  e.bc.value.fill(7.0);
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  const int n = static_cast<int>(p.centre.size());
+  for (int k = 0; k < n; ++k) EXPECT_LT(e.forces()[k].norm(), 1e-12);
+  for (int w = 0; w < 6; ++w) {  // walls are pushed outwards by p times their area
+    Vec3 expected = Vec3::Zero();
+    expected[wall_axis(w)] = wall_is_max(w) ? 7.0 : -7.0;
+    EXPECT_LT((e.forces()[n + w] - expected).norm(), 1e-12);
+  }
+}
+
+TEST(FlowModel, ViscosityAndPermeabilityFactorScaleFluxesNotPressures) {
+  const auto p = test::random_packing(200, 26);
+  FlowEngine a = permeameter(0), b = permeameter(0);
+  b.settings.conductance.viscosity = 7.0;
+  b.settings.conductance.permeability_factor = 0.3;
+  a.step(p.centre, p.radius, p.walls, 1.0);
+  b.step(p.centre, p.radius, p.walls, 1.0);
+  // Identical in exact arithmetic; the two factorisations differ by round-off times cond(G).
+  for (std::size_t c = 0; c < a.pressure().size(); ++c) EXPECT_NEAR(a.pressure()[c], b.pressure()[c], 1e-10);
+  for (std::size_t k = 0; k < a.forces().size(); ++k) EXPECT_LT((a.forces()[k] - b.forces()[k]).norm(), 1e-10);
+  EXPECT_NEAR(b.boundary_flux(1), a.boundary_flux(1) * 0.3 / 7.0, 1e-12 * std::abs(a.boundary_flux(1)));
+}
+
+TEST(FlowModel, CompressionExpelsExactlyTheVolumeLost) {
+  // Shrink the packing towards the centre: the pores lose volume, the pressure rises, and
+  // the fluid leaving through the drained walls equals the volume lost by the unknown cells.
+  auto p = test::random_packing(250, 27);
+  FlowEngine e;
+  e.bc.is_pressure = {false, false, true, true, false, false};
+  e.settings.def_tolerance = 0;  // keep the mesh
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  for (auto& x : p.centre) x = Vec3(0.5, 0.5, 0.5) + 0.999 * (x - Vec3(0.5, 0.5, 0.5));
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(e.remesh_count(), 1);
+  EXPECT_GT(e.average_pressure(), 0);
+  const double out = e.boundary_flux(2) + e.boundary_flux(3);
+  EXPECT_GT(out, 0);
+  EXPECT_NEAR(out, -e.volume_rate_total(), 1e-8 * out);
+}
+
+TEST(FlowEngine, BadInputIsRejectedAndLeavesTheEngineUsable) {
+  auto p = test::random_packing(100, 28);
+  FlowEngine e = permeameter(0);
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  const auto before = e.pressure();
+  auto bad = p;
+  bad.centre[5].x() = NAN;
+  EXPECT_THROW(e.step(bad.centre, bad.radius, bad.walls, 1.0), std::invalid_argument);
+  bad = p;
+  bad.centre[7].y() = 1.5;
+  EXPECT_THROW(e.step(bad.centre, bad.radius, bad.walls, 1.0), std::invalid_argument);
+  bad = p;
+  bad.centre[3] = bad.centre[4];
+  e.request_remesh();
+  EXPECT_THROW(e.step(bad.centre, bad.radius, bad.walls, 1.0), std::invalid_argument);
+  bad = p;
+  bad.centre[3] = bad.centre[4] + Vec3(0.5 * bad.radius[4], 0, 0);
+  e.request_remesh();
+  EXPECT_THROW(e.step(bad.centre, bad.radius, bad.walls, 1.0), std::invalid_argument);
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  ASSERT_EQ(e.pressure().size(), before.size());
+  for (std::size_t c = 0; c < before.size(); ++c) EXPECT_NEAR(e.pressure()[c], before[c], 1e-12);
+}
+
+TEST(FlowEngine, NoPressureBoundaryIsASingularSystem) {
+  const auto p = test::random_packing(50, 29);
+  FlowEngine e;
+  try {
+    e.step(p.centre, p.radius, p.walls, 1.0);
+    FAIL() << "expected a singular-system error";
+  } catch (const std::domain_error& err) {
+    EXPECT_NE(std::string(err.what()).find("no boundary has an imposed pressure"), std::string::npos);
+  }
+}

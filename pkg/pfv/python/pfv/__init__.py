@@ -1,5 +1,16 @@
 """PFV: pore-scale finite-volume fluid coupling for YADE.
 
 ``from pfv import FlowEngine`` replaces YADE's built-in FlowEngine in a scene script.
+The C++ engine alone is ``pfv.Engine`` (usable without YADE).
 """
-from ._core import Engine  # noqa: F401
+from ._core import Engine, set_num_threads, get_max_threads  # noqa: F401
+
+try:
+    from .flow_engine import FlowEngine  # noqa: F401  (needs YADE's Python modules)
+except ImportError as _error:  # plain python3.11 without yade: the core stays usable
+    _yade_import_error = _error
+
+    def __getattr__(name):
+        if name == "FlowEngine":
+            raise ImportError(f"pfv.FlowEngine needs YADE (run the script with yade-double): {_yade_import_error}")
+        raise AttributeError(name)

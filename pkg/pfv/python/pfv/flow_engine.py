@@ -1,0 +1,367 @@
+"""YADE adapter: ``pfv.FlowEngine``, a drop-in replacement for YADE's FlowEngine.
+
+The object is a PyRunner placed in ``O.engines`` like YADE's engine (after the
+InteractionLoop, before NewtonIntegrator). Each step it reads the sphere positions in bulk,
+runs the C++ pipeline (remesh when due, dV/dt, solve, forces) and adds the fluid forces to
+the spheres and to the six wall bodies. Attribute names and sign conventions are YADE's.
+
+An attribute YADE's FlowEngine has but PFV does not support may only be set to YADE's
+default value; any other value raises NotImplementedError naming it. Misspelt names raise
+AttributeError. Nothing is silently ignored.
+"""
+import ast
+import warnings
+import weakref
+
+import numpy as np
+
+import yade
+from yade.wrapper import PyRunner, Sphere, Box
+from yade.minieigenHP import Vector3
+
+from ._core import Engine, set_num_threads
+from ._yade_api import ATTRIBUTES as _YADE_ATTRIBUTES, METHODS as _YADE_METHODS
+
+__all__ = ["FlowEngine"]
+
+_engines = weakref.WeakValueDictionary()  # PyRunner commands find their engine here
+
+
+def _run(key):
+    engine = _engines.get(key)
+    if engine is None:
+        raise RuntimeError(
+            "this pfv.FlowEngine no longer exists: after O.save/O.load YADE restores it as a "
+            "plain PyRunner; create a new pfv.FlowEngine and put it back into O.engines")
+    engine._step()
+
+
+def _as_bool6(name, value):
+    value = list(value)
+    if len(value) != 6:
+        raise ValueError(f"{name} needs 6 values (xmin, xmax, ymin, ymax, zmin, zmax)")
+    return [bool(v) for v in value]
+
+
+def _as_float6(name, value):
+    value = [float(v) for v in value]
+    if len(value) != 6:
+        raise ValueError(f"{name} needs 6 values (xmin, xmax, ymin, ymax, zmin, zmax)")
+    return value
+
+
+# Python-side state attributes (not YADE attributes).
+_INTERNAL = frozenset({
+    "_core", "_key", "_ids", "_rows", "_radii", "_wall_rows", "_wall_half", "_n_bodies",
+    "_boundary_use_max_min", "_wall_ids", "_warned", "_vertex_of_id",
+})
+# YADE attributes PFV implements, with the core attribute they map to (or None if handled here).
+_SUPPORTED = {
+    "viscosity": "viscosity",
+    "permeabilityFactor": "permeability_factor",
+    "clampKValues": "clamp_k_values",
+    "minKdivKmean": "min_k_div_k_mean",
+    "maxKdivKmean": "max_k_div_k_mean",
+    "slipBoundary": "slip_boundary",
+    "useSolver": "use_solver",
+    "tolerance": "tolerance",
+    "relax": "relax",
+    "forceMetis": "force_metis",
+    "meshUpdateInterval": "mesh_update_interval",
+    "defTolerance": "def_tolerance",
+    "pZero": "p_zero",
+}
+
+
+class FlowEngine(PyRunner):
+    """PFV's DEM-PFV flow engine with the interface of YADE's FlowEngine."""
+
+    xmin, xmax, ymin, ymax, zmin, zmax = range(6)
+
+    def __init__(self, **kwargs):
+        PyRunner.__init__(self)
+        object.__setattr__(self, "_core", Engine())
+        object.__setattr__(self, "_key", id(self))
+        object.__setattr__(self, "_boundary_use_max_min", [True] * 6)
+        object.__setattr__(self, "_wall_ids", list(range(6)))
+        object.__setattr__(self, "_warned", set())
+        object.__setattr__(self, "_ids", None)
+        _engines[self._key] = self
+        self.command = f"__import__('pfv.flow_engine').flow_engine._run({self._key})"
+        self.iterPeriod = 1
+        self.initRun = True
+        self._core.use_solver = 3
+        for name, value in kwargs.items():
+            setattr(self, name, value)
+
+    # -- attribute surface -------------------------------------------------------------
+    def __setattr__(self, name, value):
+        if name in _SUPPORTED:
+            setattr(self._core, _SUPPORTED[name], value)
+        elif name in _INTERNAL or name in _PYRUNNER_ATTRIBUTES:
+            object.__setattr__(self, name, value)
+        elif name in _YADE_ATTRIBUTES:
+            _check_default(name, value)
+        else:
+            raise AttributeError(f"pfv.FlowEngine has no attribute '{name}' (and neither has YADE's FlowEngine)")
+
+    def __getattr__(self, name):  # only called when normal lookup fails
+        if name in _SUPPORTED:
+            return getattr(self._core, _SUPPORTED[name])
+        if name in _YADE_METHODS:
+            raise NotImplementedError(f"pfv.FlowEngine does not support YADE FlowEngine method '{name}' yet")
+        if name in _YADE_ATTRIBUTES:
+            return _default(name)
+        raise AttributeError(f"pfv.FlowEngine has no attribute '{name}'")
+
+    @property
+    def bndCondIsPressure(self):
+        return list(self._core.bnd_is_pressure)
+
+    @bndCondIsPressure.setter
+    def bndCondIsPressure(self, value):
+        self._core.bnd_is_pressure = _as_bool6("bndCondIsPressure", value)
+
+    @property
+    def bndCondValue(self):
+        return list(self._core.bnd_value)
+
+    @bndCondValue.setter
+    def bndCondValue(self, value):
+        self._core.bnd_value = _as_float6("bndCondValue", value)
+
+    @property
+    def boundaryUseMaxMin(self):
+        return list(self._boundary_use_max_min)
+
+    @boundaryUseMaxMin.setter
+    def boundaryUseMaxMin(self, value):
+        object.__setattr__(self, "_boundary_use_max_min", _as_bool6("boundaryUseMaxMin", value))
+        self._core.request_remesh()
+
+    @property
+    def wallIds(self):
+        return list(self._wall_ids)
+
+    @wallIds.setter
+    def wallIds(self, value):
+        value = [int(v) for v in value]
+        if len(value) != 6:
+            raise ValueError("wallIds needs 6 body ids (xmin, xmax, ymin, ymax, zmin, zmax)")
+        object.__setattr__(self, "_wall_ids", value)
+        object.__setattr__(self, "_ids", None)
+
+    @property
+    def updateTriangulation(self):
+        return self._core.remesh_due()
+
+    @updateTriangulation.setter
+    def updateTriangulation(self, value):
+        if value:
+            self._core.request_remesh()
+
+    @property
+    def ompThreads(self):
+        return -1
+
+    @ompThreads.setter
+    def ompThreads(self, value):
+        set_num_threads(int(value) if value > 0 else yade.O.numThreads)
+
+    # -- the step ---------------------------------------------------------------------------
+    def _scan_bodies(self):
+        """Sphere ids and radii, wall bodies; done at each remesh (bodies may change)."""
+        O = yade.O
+        if O.periodic:
+            raise NotImplementedError("pfv.FlowEngine does not support periodic scenes yet")
+        ids, radii, rows, others, clumps = [], [], [], 0, 0
+        row_of = {}
+        wall_set = set(self._wall_ids)
+        for row, b in enumerate(O.bodies):
+            row_of[b.id] = row
+            if b.id in wall_set:
+                continue
+            if b.isClump or b.isClumpMember:
+                clumps += 1
+            elif isinstance(b.shape, Sphere):
+                ids.append(b.id)
+                radii.append(b.shape.radius)
+                rows.append(row)
+            else:
+                others += 1
+        if clumps:
+            raise NotImplementedError(
+                f"pfv.FlowEngine does not support clumps yet ({clumps} clump bodies or members in the scene)")
+        if others and "others" not in self._warned:
+            self._warned.add("others")
+            warnings.warn(f"pfv.FlowEngine: {others} bodies that are neither spheres nor the six walls "
+                          "are left out of the flow", stacklevel=2)
+        wall_rows, wall_half = [], []
+        for w, bid in enumerate(self._wall_ids):
+            if bid not in row_of:
+                if not self._boundary_use_max_min[w]:
+                    raise ValueError(f"wallIds[{w}] = {bid} is not a body of the scene")
+                wall_rows.append(-1)
+                wall_half.append(0.0)
+                continue
+            b = O.bodies[bid]
+            wall_rows.append(row_of[bid])
+            # A box wall bounds the domain with its inner face.
+            half = b.shape.extents[w // 2] if isinstance(b.shape, Box) else 0.0
+            wall_half.append(-half if w % 2 else half)
+        vertex_of_id = {bid: k for k, bid in enumerate(ids)}
+        for w, bid in enumerate(self._wall_ids):
+            vertex_of_id.setdefault(bid, len(ids) + w)
+        object.__setattr__(self, "_ids", np.array(ids, dtype=np.int64))
+        object.__setattr__(self, "_rows", np.array(rows, dtype=np.int64))
+        object.__setattr__(self, "_radii", np.array(radii, dtype=float))
+        object.__setattr__(self, "_wall_rows", wall_rows)
+        object.__setattr__(self, "_wall_half", wall_half)
+        object.__setattr__(self, "_n_bodies", len(O.bodies))
+        object.__setattr__(self, "_vertex_of_id", vertex_of_id)
+
+    def _positions(self):
+        cad = yade._utils.coordsAndDisplacements
+        return np.array([cad(0)[0], cad(1)[0], cad(2)[0]]).T
+
+    def _walls(self, xyz, pos):
+        walls = [0.0] * 6
+        for w in range(6):
+            axis = w // 2
+            if self._boundary_use_max_min[w]:
+                walls[w] = float((pos[:, axis] + self._radii).max() if w % 2 else (pos[:, axis] - self._radii).min())
+            else:
+                walls[w] = float(xyz[self._wall_rows[w], axis] + self._wall_half[w])
+        return walls
+
+    def _step(self):
+        O = yade.O
+        core = self._core
+        if self._ids is None or core.remesh_due() or len(O.bodies) != self._n_bodies:
+            self._scan_bodies()
+            core.request_remesh()
+        xyz = self._positions()
+        pos = xyz[self._rows]
+        core.step(pos, self._radii, self._walls(xyz, pos), O.dt)
+        forces = core.forces().tolist()
+        add = O.forces.addF
+        for bid, f in zip(self._ids.tolist(), forces):
+            add(bid, f)
+        n = len(self._ids)
+        for w, bid in enumerate(self._wall_ids):
+            if self._wall_rows[w] >= 0:
+                add(bid, forces[n + w])
+
+    def emulateAction(self):
+        """Run one flow step outside the time-stepping loop, as YADE's method does."""
+        self._step()
+
+    # -- boundary conditions --------------------------------------------------------------
+    def updateBCs(self):
+        """Apply changed boundary values and types (PFV applies values at every step anyway)."""
+        self._core.request_bc_update()
+
+    def imposePressure(self, pos, p):
+        return self._core.impose_pressure(tuple(pos), float(p))
+
+    def setImposedPressure(self, cond, p):
+        self._core.set_imposed_pressure(int(cond), float(p))
+
+    def clearImposedPressure(self):
+        self._core.clear_imposed_pressure()
+
+    def imposeFlux(self, pos, p):
+        """YADE's sign: outflux positive, influx negative."""
+        self._core.impose_flux(tuple(pos), -float(p))
+
+    def clearImposedFlux(self):
+        self._core.clear_imposed_flux()
+
+    # -- queries ----------------------------------------------------------------------------
+    def _require_mesh(self):
+        if not self._core.has_mesh():
+            raise RuntimeError("the flow engine has not run yet: no pore mesh (run at least one step)")
+
+    def _cell_at(self, pos):
+        self._require_mesh()
+        cell = self._core.locate(tuple(float(x) for x in pos))
+        if cell < 0:
+            raise ValueError(f"point {tuple(pos)} lies in no pore cell (outside the walls or the packing)")
+        return cell
+
+    def getPorePressure(self, pos):
+        return self._core.cell_pressure(self._cell_at(pos))
+
+    def getCell(self, X, Y, Z):
+        self._require_mesh()
+        return self._core.locate((float(X), float(Y), float(Z)))
+
+    def getCellPressure(self, id):
+        return self._core.cell_pressure(int(id))
+
+    def getCellCenter(self, id):
+        return Vector3(*self._core.cell_center(int(id)))
+
+    def getCellVolume(self, pos):
+        return self._core.cell_volume(self._cell_at(pos))
+
+    def getBoundaryFlux(self, boundary):
+        self._require_mesh()
+        if boundary not in self._wall_ids:
+            raise ValueError(f"body {boundary} is not one of the boundaries wallIds = {self._wall_ids}")
+        return self._core.boundary_flux(self._wall_ids.index(boundary))
+
+    def fluidForce(self, idSph):
+        self._require_mesh()
+        v = self._vertex_of_id.get(int(idSph))
+        if v is None:
+            raise ValueError(f"body {idSph} is not coupled with the fluid (not a sphere nor a wall)")
+        return Vector3(*self._core.forces()[v])
+
+    def nCells(self):
+        return self._core.n_cells()
+
+    def averagePressure(self):
+        self._require_mesh()
+        return self._core.average_pressure()
+
+    def averageSlicePressure(self, posY, axis=1):
+        self._require_mesh()
+        return self._core.average_slice_pressure(int(axis), float(posY))
+
+    def metisUsed(self):
+        return self._core.metis_used()
+
+    # -- PFV extras -------------------------------------------------------------------------
+    @property
+    def core(self):
+        """The C++ engine (pfv.Engine): geometry, timings and diagnostics."""
+        return self._core
+
+
+_PYRUNNER_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
+    name for name, v in vars(FlowEngine).items() if isinstance(v, property)}
+
+
+def _default(name):
+    text = _YADE_ATTRIBUTES[name]
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return text
+
+
+def _check_default(name, value):
+    default = _default(name)
+    try:
+        same = value == default or (isinstance(default, float) and float(value) == default)
+    except (TypeError, ValueError):
+        same = False
+    if not same:
+        raise NotImplementedError(
+            f"pfv.FlowEngine does not support YADE FlowEngine attribute '{name}' yet "
+            f"(only its default value {text_of(default)} is accepted)")
+
+
+def text_of(v):
+    return repr(v)

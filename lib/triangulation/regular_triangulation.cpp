@@ -65,6 +65,7 @@ const Mesh& RegularTriangulation::build(const std::vector<Vec3>& centres,
 
   mesh_ = Mesh{};
   mesh_.n_spheres = n;
+  walls_ = walls;
   std::vector<char> present(n, 0);
   for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v)
     if (v->info() < n) present[v->info()] = 1;
@@ -107,6 +108,9 @@ const Mesh& RegularTriangulation::build(const std::vector<Vec3>& centres,
 int RegularTriangulation::locate(const Vec3& x) const {
   const RT& rt = impl_->rt;
   if (rt.dimension() < 3) return -1;
+  // Boundary cells reach the far-away wall spheres; only their part inside the box is a pore.
+  for (int w = 0; w < kWallCount; ++w)
+    if (!(walls_.height(w, x) >= 0)) return -1;
   const auto c = rt.locate(WPoint(K::Point_3(x.x(), x.y(), x.z()), 0.0));
   if (rt.is_infinite(c)) return -1;
   return c->info();
@@ -123,6 +127,13 @@ std::vector<std::pair<int, int>> RegularTriangulation::centres_inside_neighbours
     if (a >= n || b >= n) continue;
     const double d = (centres[a] - centres[b]).norm();
     if (d < std::max(radii[a], radii[b])) bad.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  // A hidden sphere has its centre inside the sphere of least power distance from it.
+  for (int k : mesh_.hidden_spheres) {
+    const Vec3& x = centres[k];
+    const auto v = rt.nearest_power_vertex(K::Point_3(x.x(), x.y(), x.z()));
+    const int h = v->info();
+    if (h < n && (centres[h] - x).norm() < radii[h]) bad.emplace_back(std::min(k, h), std::max(k, h));
   }
   return bad;
 }

@@ -34,7 +34,8 @@ class RegularTriangulation {
   // Index of the pore cell containing x, or -1 if x lies in no pore cell.
   int locate(const Vec3& x) const;
 
-  // Pairs of spheres joined by an edge with one centre inside the other sphere.
+  // Pairs of spheres with one centre inside the other sphere: neighbours in the
+  // triangulation, and each hidden sphere with the sphere that hides it.
   std::vector<std::pair<int, int>> centres_inside_neighbours(
       const std::vector<Vec3>& centres, const std::vector<double>& radii) const;
 
@@ -42,6 +43,7 @@ class RegularTriangulation {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Mesh mesh_;
+  BoxWalls walls_;
 };
 
 }  // namespace pfv

@@ -63,7 +63,7 @@ void FlowEngine::remesh(const std::vector<Vec3>& centres, const std::vector<doub
   });
   for (std::size_t i = 1; i < order.size(); ++i)
     if (centres[order[i]] == centres[order[i - 1]])
-      bad_input("spheres " + std::to_string(order[i - 1]) + " and " + std::to_string(order[i]) +
+      bad_input("sphere " + std::to_string(order[i - 1]) + " and sphere " + std::to_string(order[i]) +
                 " have coincident centres " + describe(centres[order[i]]));
 
   StageTimes t;

@@ -49,6 +49,9 @@ class FlowEngine {
             const BoxWalls& walls, double dt);
 
   void request_remesh() { remesh_requested_ = true; }
+  // Forget the previous positions: the next step has no dV/dt term. For when the boundary
+  // is redefined (a moved fictitious wall is not a change of pore volume).
+  void reset_history() { has_prev_ = false; }
   void request_bc_update() { bc_dirty_ = true; }
   bool remesh_due() const;
   bool has_mesh() const { return !cells_.volume.empty(); }

@@ -159,6 +159,7 @@ PYBIND11_MODULE(_core, m) {
       .def("clear_imposed_flux", [](FlowEngine& e) { e.bc.imposed_flux.clear(); e.request_bc_update(); })
       .def("request_remesh", &FlowEngine::request_remesh)
       .def("request_bc_update", &FlowEngine::request_bc_update)
+      .def("reset_history", &FlowEngine::reset_history)
       .def("remesh_due", &FlowEngine::remesh_due)
       .def("has_mesh", &FlowEngine::has_mesh)
       // The step.

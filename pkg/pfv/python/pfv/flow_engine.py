@@ -10,6 +10,7 @@ default value; any other value raises NotImplementedError naming it. Misspelt na
 AttributeError. Nothing is silently ignored.
 """
 import ast
+import re
 import warnings
 import weakref
 
@@ -29,10 +30,13 @@ _engines = weakref.WeakValueDictionary()  # PyRunner commands find their engine 
 
 def _run(key):
     engine = _engines.get(key)
-    if engine is None:
+    # After O.load the running PyRunner is a restored copy, not this engine (which may still be
+    # alive in this process): driving the old object would be silently wrong.
+    if engine is None or not any(e is engine for e in yade.O.engines):
         raise RuntimeError(
-            "this pfv.FlowEngine no longer exists: after O.save/O.load YADE restores it as a "
-            "plain PyRunner; create a new pfv.FlowEngine and put it back into O.engines")
+            "this pfv.FlowEngine must be re-created: after O.save/O.load YADE restores it as a "
+            "plain PyRunner, which cannot drive the flow; create a new pfv.FlowEngine and put it "
+            "back into O.engines")
     engine._step()
 
 
@@ -53,7 +57,7 @@ def _as_float6(name, value):
 # Python-side state attributes (not YADE attributes).
 _INTERNAL = frozenset({
     "_core", "_key", "_ids", "_rows", "_radii", "_wall_rows", "_wall_half", "_n_bodies",
-    "_boundary_use_max_min", "_wall_ids", "_warned", "_vertex_of_id",
+    "_boundary_use_max_min", "_wall_ids", "_warned", "_vertex_of_id", "_threads",
 })
 # YADE attributes PFV implements, with the core attribute they map to (or None if handled here).
 _SUPPORTED = {
@@ -86,6 +90,7 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_wall_ids", list(range(6)))
         object.__setattr__(self, "_warned", set())
         object.__setattr__(self, "_ids", None)
+        object.__setattr__(self, "_threads", None)  # None: follow YADE's -j
         _engines[self._key] = self
         self.command = f"__import__('pfv.flow_engine').flow_engine._run({self._key})"
         self.iterPeriod = 1
@@ -136,8 +141,11 @@ class FlowEngine(PyRunner):
 
     @boundaryUseMaxMin.setter
     def boundaryUseMaxMin(self, value):
-        object.__setattr__(self, "_boundary_use_max_min", _as_bool6("boundaryUseMaxMin", value))
-        self._core.request_remesh()
+        value = _as_bool6("boundaryUseMaxMin", value)
+        if value != self._boundary_use_max_min:
+            object.__setattr__(self, "_boundary_use_max_min", value)
+            self._core.request_remesh()
+            self._core.reset_history()
 
     @property
     def wallIds(self):
@@ -148,8 +156,10 @@ class FlowEngine(PyRunner):
         value = [int(v) for v in value]
         if len(value) != 6:
             raise ValueError("wallIds needs 6 body ids (xmin, xmax, ymin, ymax, zmin, zmax)")
-        object.__setattr__(self, "_wall_ids", value)
-        object.__setattr__(self, "_ids", None)
+        if value != self._wall_ids:
+            object.__setattr__(self, "_wall_ids", value)
+            object.__setattr__(self, "_ids", None)
+            self._core.reset_history()
 
     @property
     def updateTriangulation(self):
@@ -162,11 +172,12 @@ class FlowEngine(PyRunner):
 
     @property
     def ompThreads(self):
-        return -1
+        """Threads of the engine's parallel loops; -1 follows YADE's thread count (yade -jN)."""
+        return -1 if self._threads is None else self._threads
 
     @ompThreads.setter
     def ompThreads(self, value):
-        set_num_threads(int(value) if value > 0 else yade.O.numThreads)
+        object.__setattr__(self, "_threads", int(value) if int(value) > 0 else None)
 
     # -- the step ---------------------------------------------------------------------------
     def _scan_bodies(self):
@@ -240,9 +251,22 @@ class FlowEngine(PyRunner):
         if self._ids is None or core.remesh_due() or len(O.bodies) != self._n_bodies:
             self._scan_bodies()
             core.request_remesh()
+        set_num_threads(self._threads or O.numThreads)
         xyz = self._positions()
         pos = xyz[self._rows]
-        core.step(pos, self._radii, self._walls(xyz, pos), O.dt)
+        remeshing = core.remesh_due()
+        try:
+            core.step(pos, self._radii, self._walls(xyz, pos), O.dt)
+        except ValueError as error:  # name bodies by their YADE id, not by sphere index
+            ids = self._ids
+            message = re.sub(r"sphere (\d+)", lambda m: f"sphere #{ids[int(m.group(1))]}", str(error))
+            raise ValueError(f"pfv.FlowEngine: {message}") from None
+        if remeshing:
+            hidden = core.hidden_spheres()
+            if hidden:
+                warnings.warn(f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
+                              f"regular triangulation and get no fluid force (ids {self._ids[hidden][:10].tolist()}...)",
+                              stacklevel=2)
         forces = core.forces().tolist()
         add = O.forces.addF
         for bid, f in zip(self._ids.tolist(), forces):

@@ -23,7 +23,11 @@ from yade.minieigenHP import Vector3
 from ._core import Engine, set_num_threads
 from ._yade_api import ATTRIBUTES as _YADE_ATTRIBUTES, METHODS as _YADE_METHODS
 
-__all__ = ["FlowEngine"]
+__all__ = ["FlowEngine", "TimeStepWarning"]
+
+
+class TimeStepWarning(UserWarning):
+    """O.dt exceeds the coupled stability limit (thesis 4.20-4.22)."""
 
 _engines = weakref.WeakValueDictionary()  # PyRunner commands find their engine here
 
@@ -58,6 +62,7 @@ def _as_float6(name, value):
 _INTERNAL = frozenset({
     "_core", "_key", "_ids", "_rows", "_radii", "_wall_rows", "_wall_half", "_n_bodies",
     "_boundary_use_max_min", "_wall_ids", "_warned", "_vertex_of_id", "_threads",
+    "_mass_per_diameter", "_dt_dem", "time_step_safety", "strict_time_step",
 })
 # YADE attributes PFV implements, with the core attribute they map to (or None if handled here).
 _SUPPORTED = {
@@ -91,6 +96,12 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_warned", set())
         object.__setattr__(self, "_ids", None)
         object.__setattr__(self, "_threads", None)  # None: follow YADE's -j
+        object.__setattr__(self, "_mass_per_diameter", float("inf"))
+        object.__setattr__(self, "_dt_dem", float("inf"))
+        # O.dt must stay below time_step_safety * min(dt_MV, DEM limit) (zeta of thesis 4.22);
+        # beyond it the engine warns once, or raises if strict_time_step.
+        object.__setattr__(self, "time_step_safety", 0.8)
+        object.__setattr__(self, "strict_time_step", False)
         _engines[self._key] = self
         self.command = f"__import__('pfv.flow_engine').flow_engine._run({self._key})"
         self.iterPeriod = 1
@@ -186,6 +197,7 @@ class FlowEngine(PyRunner):
         if O.periodic:
             raise NotImplementedError("pfv.FlowEngine does not support periodic scenes yet")
         ids, radii, rows, others, clumps = [], [], [], 0, 0
+        mass_per_diameter = float("inf")  # min m/d over the dynamic coupled spheres
         row_of = {}
         wall_set = set(self._wall_ids)
         for row, b in enumerate(O.bodies):
@@ -198,6 +210,8 @@ class FlowEngine(PyRunner):
                 ids.append(b.id)
                 radii.append(b.shape.radius)
                 rows.append(row)
+                if b.dynamic and b.state.blockedDOFs != "xyzXYZ" and b.state.mass > 0:
+                    mass_per_diameter = min(mass_per_diameter, b.state.mass / (2 * b.shape.radius))
             else:
                 others += 1
         if clumps:
@@ -230,6 +244,9 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_wall_half", wall_half)
         object.__setattr__(self, "_n_bodies", len(O.bodies))
         object.__setattr__(self, "_vertex_of_id", vertex_of_id)
+        object.__setattr__(self, "_mass_per_diameter", mass_per_diameter)
+        dem = yade.utils.PWaveTimeStep() if ids else float("inf")
+        object.__setattr__(self, "_dt_dem", dem if dem > 0 else float("inf"))
 
     def _positions(self):
         cad = yade._utils.coordsAndDisplacements
@@ -252,6 +269,7 @@ class FlowEngine(PyRunner):
             self._scan_bodies()
             core.request_remesh()
         set_num_threads(self._threads or O.numThreads)
+        self._check_time_step(O.dt)
         xyz = self._positions()
         pos = xyz[self._rows]
         remeshing = core.remesh_due()
@@ -275,6 +293,35 @@ class FlowEngine(PyRunner):
         for w, bid in enumerate(self._wall_ids):
             if self._wall_rows[w] >= 0:
                 add(bid, forces[n + w])
+
+    @property
+    def viscous_time_step(self):
+        """dt_MV = pi rho d^2 / (1200 mu) at the smallest rho d^2 of the coupled dynamic spheres (thesis 4.20)."""
+        if self._ids is None:
+            self._scan_bodies()
+        # pi rho d^2 / (1200 mu) with rho = 6 m / (pi d^3) is m / (200 mu d).
+        return self._mass_per_diameter / (200.0 * self._core.viscosity)
+
+    @property
+    def critical_time_step(self):
+        """min(dt_MV, DEM P-wave limit): O.dt should not exceed time_step_safety times this."""
+        if self._ids is None:
+            self._scan_bodies()
+        return min(self.viscous_time_step, self._dt_dem)
+
+    def _check_time_step(self, dt):
+        dt_mv = self.viscous_time_step
+        limit = self.time_step_safety * min(dt_mv, self._dt_dem)
+        if dt <= limit:
+            return
+        message = (f"pfv.FlowEngine: O.dt = {dt:.4g} exceeds the coupled stability limit "
+                   f"{self.time_step_safety:g} x min(dt_MV = {dt_mv:.4g}, dt_DEM = {self._dt_dem:.4g}) "
+                   f"= {limit:.4g}; the explicit coupling may blow up (thesis 4.20-4.22)")
+        if self.strict_time_step:
+            raise ValueError(message)
+        if "dt" not in self._warned:
+            self._warned.add("dt")
+            warnings.warn(message, TimeStepWarning, stacklevel=2)
 
     def emulateAction(self):
         """Run one flow step outside the time-stepping loop, as YADE's method does."""

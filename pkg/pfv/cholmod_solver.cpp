@@ -2,6 +2,7 @@
 
 #include <suitesparse/cholmod.h>
 
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -45,17 +46,23 @@ double CholmodSolver::factor_nonzeros() const {
   return factor_ ? common_->c.lnz : 0.0;
 }
 
-void CholmodSolver::factorize(const PressureSystem& s, bool force_metis) {
+double CholmodSolver::factor_flops() const {
+  return factor_ ? common_->c.fl : 0.0;
+}
+
+void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering) {
   release();
   cholmod_common* c = &common_->c;
   const int n = s.n_unknowns();
   if (n == 0) return;
-  if (force_metis) {
-    c->nmethods = 1;
-    c->method[0].ordering = CHOLMOD_METIS;
-    c->postorder = 1;
+  c->postorder = 1;
+  if (ordering == Ordering::kAuto) {
+    c->nmethods = 0;
   } else {
-    c->nmethods = 0;  // CHOLMOD's default: AMD, then METIS if AMD fills badly
+    c->nmethods = 1;
+    c->method[0].ordering = ordering == Ordering::kAmd     ? CHOLMOD_AMD
+                            : ordering == Ordering::kMetis ? CHOLMOD_METIS
+                                                           : CHOLMOD_NESDIS;
   }
   // A view of the assembled arrays; CHOLMOD only reads them.
   cholmod_sparse a{};
@@ -71,10 +78,12 @@ void CholmodSolver::factorize(const PressureSystem& s, bool force_metis) {
   a.sorted = 1;
   a.packed = 1;
 
+  const auto t0 = std::chrono::steady_clock::now();
   cholmod_factor* f = cholmod_analyze(&a, c);
+  analysis_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!f) throw std::runtime_error("CHOLMOD analysis failed (status " + std::to_string(c->status) + ")");
   factor_ = f;
-  metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS;
+  metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
   cholmod_factorize(&a, f, c);
   if (c->status == CHOLMOD_NOT_POSDEF || f->minor < static_cast<size_t>(n)) {
     const auto minor = f->minor;

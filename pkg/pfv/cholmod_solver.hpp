@@ -8,6 +8,9 @@ namespace pfv {
 
 struct PressureSystem;
 
+// Fill-reducing ordering. kAuto is CHOLMOD's default (AMD, then METIS if AMD fills badly).
+enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
+
 class CholmodSolver {
  public:
   CholmodSolver();
@@ -16,11 +19,13 @@ class CholmodSolver {
   CholmodSolver& operator=(const CholmodSolver&) = delete;
 
   // Throws std::domain_error if G is not positive definite.
-  void factorize(const PressureSystem& system, bool force_metis);
+  void factorize(const PressureSystem& system, Ordering ordering);
   void solve(const std::vector<double>& rhs, std::vector<double>& x);
   bool metis_used() const { return metis_used_; }
   bool ready() const { return factor_ != nullptr; }
   double factor_nonzeros() const;
+  double factor_flops() const;
+  double analysis_seconds() const { return analysis_seconds_; }  // ordering + symbolic
 
  private:
   void release();
@@ -32,6 +37,7 @@ class CholmodSolver {
   void* work_y_ = nullptr;
   void* work_e_ = nullptr;
   bool metis_used_ = false;
+  double analysis_seconds_ = 0;
 };
 
 }  // namespace pfv

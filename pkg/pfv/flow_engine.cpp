@@ -121,6 +121,7 @@ void FlowEngine::remesh(const std::vector<Vec3>& centres, const std::vector<doub
   volume_.assign(cells_.volume.begin(), cells_.volume.end());
   volume_rate_.assign(mesh.n_cells(), 0.0);
   t.assembly = remesh_times_.assembly;
+  t.analysis = remesh_times_.analysis;
   t.factorization = remesh_times_.factorization;
   remesh_times_ = t;
   strain_ = 0;
@@ -151,8 +152,10 @@ void FlowEngine::rebuild_system() {
 
   t0 = Clock::now();
   auto solver = std::make_unique<CholmodSolver>();
-  if (settings.use_solver != 0) solver->factorize(system, settings.force_metis);
-  remesh_times_.factorization = seconds_since(t0);
+  if (settings.use_solver != 0)
+    solver->factorize(system, settings.force_metis ? Ordering::kMetis : settings.ordering);
+  remesh_times_.analysis = solver->analysis_seconds();
+  remesh_times_.factorization = seconds_since(t0) - remesh_times_.analysis;
 
   system_ = std::move(system);
   dirichlet_coupling_ = std::move(coupling);

@@ -25,7 +25,8 @@ struct EngineSettings {
   double tolerance = 1e-6;
   double relax = 1.9;
   int max_gs_iterations = 200000;
-  bool force_metis = false;
+  bool force_metis = false;  // YADE's forceMetis: METIS ordering whatever 'ordering' says
+  Ordering ordering = Ordering::kAuto;
   int mesh_update_interval = 1000;
   double def_tolerance = 0.05;
   double p_zero = 0;
@@ -33,7 +34,7 @@ struct EngineSettings {
 
 // Seconds spent in each stage: the last remesh, and the last step without remesh.
 struct StageTimes {
-  double triangulation = 0, geometry = 0, conductance = 0, assembly = 0, factorization = 0;
+  double triangulation = 0, geometry = 0, conductance = 0, assembly = 0, analysis = 0, factorization = 0;
   double force_cache = 0, volumes = 0, solve = 0, forces = 0;
 };
 
@@ -72,6 +73,7 @@ class FlowEngine {
   double average_slice_pressure(int axis, double position) const;
   int locate(const Vec3& x) const { return tri_.locate(x); }
   bool metis_used() const { return cholmod_->metis_used(); }
+  const CholmodSolver& cholmod() const { return *cholmod_; }
   int remesh_count() const { return remesh_count_; }
   int gs_iterations() const { return gs_iterations_; }
   const StageTimes& remesh_times() const { return remesh_times_; }

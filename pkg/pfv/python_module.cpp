@@ -5,6 +5,8 @@
 #include <pybind11/stl.h>
 
 #include <cstring>
+#include <map>
+#include <string>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -54,6 +56,7 @@ py::dict times_dict(const StageTimes& t) {
   d["geometry"] = t.geometry;
   d["conductance"] = t.conductance;
   d["assembly"] = t.assembly;
+  d["analysis"] = t.analysis;
   d["factorization"] = t.factorization;
   d["force_cache"] = t.force_cache;
   d["volumes"] = t.volumes;
@@ -126,6 +129,21 @@ PYBIND11_MODULE(_core, m) {
                     [](FlowEngine& e, int v) { e.settings.max_gs_iterations = v; })
       .def_property("force_metis", [](const FlowEngine& e) { return e.settings.force_metis; },
                     [](FlowEngine& e, bool v) { e.settings.force_metis = v; e.request_bc_update(); })
+      .def_property("ordering",
+                    [](const FlowEngine& e) {
+                      const char* names[] = {"auto", "amd", "metis", "nesdis"};
+                      return std::string(names[static_cast<int>(e.settings.ordering)]);
+                    },
+                    [](FlowEngine& e, const std::string& v) {
+                      const std::map<std::string, Ordering> names{{"auto", Ordering::kAuto}, {"amd", Ordering::kAmd},
+                                                                  {"metis", Ordering::kMetis}, {"nesdis", Ordering::kNestedDissection}};
+                      const auto it = names.find(v);
+                      if (it == names.end()) throw py::value_error("ordering must be one of auto, amd, metis, nesdis");
+                      e.settings.ordering = it->second;
+                      e.request_bc_update();
+                    })
+      .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholmod().factor_nonzeros(); })
+      .def("factor_flops", [](const FlowEngine& e) { return e.cholmod().factor_flops(); })
       .def_property("mesh_update_interval", [](const FlowEngine& e) { return e.settings.mesh_update_interval; },
                     [](FlowEngine& e, int v) { e.settings.mesh_update_interval = v; })
       .def_property("def_tolerance", [](const FlowEngine& e) { return e.settings.def_tolerance; },

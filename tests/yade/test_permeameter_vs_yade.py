@@ -33,6 +33,10 @@ HERE = _here()
 DP = 1.0            # applied pressure drop
 VISCOSITY = 1.0
 TOL_FLUX = 0.05     # relative to YADE's flux
+# No-slip lateral walls: there both engines follow thesis eqs 3.4-3.5. With slip walls (YADE's default)
+# YADE also multiplies R_h of wall throats by 2^(-n/4), which the thesis does not have and which lowers
+# its flux by ~15 % on this scene (doc/yade-differences.md); that case is not a like-for-like comparison.
+SLIP = False
 TOL_PRESSURE = 0.05  # relative to DP
 TOL_FORCE_MEDIAN = 0.10
 TOL_TOTAL = 0.05
@@ -55,7 +59,7 @@ def run_engine(make_flow, axis, steps, label):
     d = scenes.build_permeameter()
     flow = make_flow()
     flow.label = 'flow'
-    scenes.configure_flow(flow, axis=axis, dp=DP, viscosity=VISCOSITY)
+    scenes.configure_flow(flow, axis=axis, dp=DP, viscosity=VISCOSITY, slipBoundary=SLIP)
     scenes.insert_flow(flow)
     lo, hi = 2 * axis, 2 * axis + 1
     t0 = time.perf_counter()

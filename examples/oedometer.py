@@ -1,0 +1,565 @@
+# -*- coding: utf-8 -*-
+"""Oedometer (1-D consolidation) with the DEM-PFV coupling, compared with Terzaghi's theory.
+
+    yade-double -n -x examples/oedometer.py [--quick] [--engine=pfv|yade] [--nonlinear]
+                                            [--drainage=top|both] [--out=DIR]
+    yade-double examples/oedometer.py                  # same, with the GUI and live plots
+    yade-double -n -x examples/oedometer.py --compare=DIR_A,DIR_B [--out=DIR]   # plot two runs together
+
+Thesis section 4.4 (spec ../shared/model-spec.md section 8). The script
+
+1. prepares a dense packing (particle growth under a TriaxialStressController, then friction raised), switches to
+   oedometric conditions (rigid lateral walls, fixed bottom, stress-controlled top wall) and measures the oedometric
+   modulus E_oed from a dry load-unload-reload cycle of the same stress increment as the consolidation load.
+   This dry part does not involve the fluid: it is saved in PFV_CACHE_DIR (or /tmp/pfv-oedometer-cache) and every
+   later run with the same preparation parameters, whatever the engine, starts from the IDENTICAL saved state;
+2. switches the flow engine on (PFV's by default, YADE's built-in one with --engine=yade) and measures the hydraulic
+   conductivity K from one step of a permeameter (pressure dp on the bottom, 0 on the top, spheres at rest);
+3. loads the top wall by `load` and records settlement and excess pore pressure against time. Drainage:
+   --drainage=top (default, YADE's example): drained top wall, impermeable bottom, drainage length L = H;
+   --drainage=both (the thesis): drained top and bottom, L = H/2.
+   The fluid forces act on the wall bodies too, so the bottom wall reads the total stress (effective + pore);
+4. compares with Terzaghi's series solution using the measured C_v = K E_oed / gamma_w:
+   U(T_v) (settlement / dry settlement under the same increment) and isochrones p(z, T_v), and prints the error
+   figures: max |U_sim - U_theory| and the RMS isochrone pressure error normalised by the load.
+
+With --nonlinear the load is 200 kPa (thesis 4.4.2): the dry secant modulus under that load and the conductivity
+measured again at the end give C_v,final, and U(T_v) is compared with both the initial and the final C_v.
+
+Outputs in --out (default ./oedometer-<engine>[-quick][-nonlinear]): timeseries.csv, isochrones.csv, summary.json,
+oedometer.png. The exit status is 0 when the run completes (the thresholds are in tests/yade/test_oedometer_quick.py).
+Pressures are piezometric (no gravity anywhere in this example).
+"""
+import hashlib
+import json
+import math
+import os
+import sys
+import tempfile
+import time
+
+# ------------------------------------------------------------------------------------------------------------
+# Parameters (SI units). Thesis Table 4.1: 5000 grains in a 0.1 m cube, E = 15 MPa, k_t/k_n = 0.5, load 5 kPa,
+# mu = 250 Pa.s. The full size here keeps 5000 grains; the viscosity is lower than the thesis' so that the
+# consolidation takes tens of thousands of steps instead of millions: the coupled time step is limited by
+# dt_MV = pi rho d^2 / (1200 mu) (thesis 4.20), which would be 20 times smaller than the DEM limit at mu = 250.
+# Consolidation stays slow compared with the elastic waves (t_c / t_wave is printed).
+# ------------------------------------------------------------------------------------------------------------
+FULL = dict(
+    num_spheres=5000,      # number of spheres
+    viscosity=20.0,        # fluid dynamic viscosity mu [Pa.s]
+    load=5.0e3,            # consolidation load: increment of the vertical stress on the top wall [Pa]
+    Tv_end=1.5,            # run the consolidation until this time factor
+)
+QUICK = dict(num_spheres=1000, viscosity=10.0, load=5.0e3, Tv_end=1.0)
+NONLINEAR_LOAD = 200.0e3   # --nonlinear: thesis 4.4.2
+COMMON = dict(
+    box=0.1,               # side of the initial cube [m]
+    rRelFuzz=0.2,          # "slightly polydisperse": radii r_mean (1 +- 0.2)
+    seed=1,                # makeCloud seed
+    young=15.0e6,          # contact modulus E: k_n = 2 E R1 R2 / (R1 + R2) (thesis 4.1)
+    poisson=0.5,           # k_t / k_n (thesis 4.2, a = 0.5)
+    density=2600.0,        # grain density [kg/m3]
+    compaction_friction=3.0,   # friction angle during the isotropic compaction [deg] (dense sample)
+    friction=30.0,         # friction angle for the oedometer [deg]
+    sigma0=10.0e3,         # isotropic compaction stress, then initial vertical stress [Pa]
+    gamma_w=1.0e4,         # unit weight of the fluid rho_f g [N/m3]: K = kappa gamma_w / mu
+    zeta=0.8,              # coupled time step = zeta * min(dt_MV, P-wave DEM step) (thesis 4.22)
+    perm_dp=1.0,           # permeameter pressure drop [Pa] (tiny compared with sigma0)
+    mesh_update_interval=1000,  # remesh the pores every so many steps (both engines)
+    isochrones=(0.01, 0.05, 0.1, 0.2, 0.5, 1.0),  # T_v of the recorded pressure profiles
+    profile_points=10,     # heights of a profile, at (i + 0.5) / n of the height
+    slice_grid=6,          # a slice average is the mean pressure over grid x grid points of the horizontal slice
+    dry_damping=0.2,       # NewtonIntegrator damping of the dry phases; the coupled phase has none
+)
+CACHE_VERSION = 1
+
+# ------------------------------------------------------------------------------------------------------------
+from yade import O, utils, runtime  # noqa: E402
+from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, GlobalStiffnessTimeStepper,  # noqa: E402
+                          Ig2_Box_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
+                          Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator,
+                          TriaxialStressController, Sphere)
+from yade import pack  # noqa: E402
+import numpy as np  # noqa: E402
+
+XMIN, XMAX, YMIN, YMAX, ZMIN, ZMAX = range(6)  # aabbWalls order = FlowEngine.wallIds order
+BOTTOM, TOP = YMIN, YMAX                        # the vertical axis is y (as in YADE's example)
+HEADLESS = bool(getattr(runtime.opts, 'nogui', True)) or not getattr(runtime, 'hasDisplay', False)
+
+
+def log(*args):
+    print('oedometer:', *args, flush=True)
+
+
+# ---------------------------------------------------------------- Terzaghi -----------------------------------
+_M = (2 * np.arange(4000) + 1) * np.pi / 2
+
+
+def terzaghi_U(Tv):
+    """Average degree of consolidation U(T_v) = 1 - sum 2/M^2 exp(-M^2 T_v)."""
+    Tv = np.atleast_1d(np.asarray(Tv, dtype=float))
+    return 1 - (2 / _M[None, :] ** 2 * np.exp(-np.outer(np.maximum(Tv, 0), _M ** 2))).sum(axis=1)
+
+
+def terzaghi_p(zeta, Tv):
+    """Excess pore pressure / load at zeta = distance from the drained face / drainage length L."""
+    zeta = np.atleast_1d(np.asarray(zeta, dtype=float))
+    if Tv <= 0:
+        return np.ones_like(zeta)
+    terms = 2 / _M[None, :] * np.sin(np.outer(zeta, _M)) * np.exp(-_M[None, :] ** 2 * Tv)
+    return terms.sum(axis=1)
+
+
+# ---------------------------------------------------------------- options -----------------------------------
+def parse_args(argv):
+    opts = dict(quick=False, engine='pfv', nonlinear=False, drainage='top', out=None, compare=None)
+    for a in argv:
+        if a == '--quick':
+            opts['quick'] = True
+        elif a == '--nonlinear':
+            opts['nonlinear'] = True
+        elif a.startswith('--engine='):
+            opts['engine'] = a.split('=', 1)[1]
+        elif a.startswith('--drainage='):
+            opts['drainage'] = a.split('=', 1)[1]
+        elif a.startswith('--out='):
+            opts['out'] = a.split('=', 1)[1]
+        elif a.startswith('--compare='):
+            opts['compare'] = a.split('=', 1)[1].split(',')
+        elif a.endswith('.py') and not a.startswith('-'):
+            continue  # yade may leave the script name in argv
+        else:
+            raise SystemExit('oedometer: unknown argument %r (see the docstring)' % a)
+    if opts['engine'] not in ('pfv', 'yade'):
+        raise SystemExit('oedometer: --engine must be pfv or yade')
+    if opts['drainage'] not in ('top', 'both'):
+        raise SystemExit('oedometer: --drainage must be top or both')
+    return opts
+
+
+def parameters(opts):
+    P = dict(COMMON)
+    P.update(QUICK if opts['quick'] else FULL)
+    if opts['nonlinear']:
+        P['load'] = NONLINEAR_LOAD
+    P['small_load'] = (QUICK if opts['quick'] else FULL)['load']  # increment of the dry E_oed cycle
+    P['drainage'] = opts['drainage']
+    return P
+
+
+# ---------------------------------------------------------------- dry preparation ---------------------------
+def cache_dir():
+    return os.environ.get('PFV_CACHE_DIR') or os.path.join(tempfile.gettempdir(), 'pfv-oedometer-cache')
+
+
+def prep_key(P):
+    keys = ('num_spheres', 'box', 'rRelFuzz', 'seed', 'young', 'poisson', 'density', 'compaction_friction', 'friction',
+            'sigma0', 'small_load', 'dry_damping')
+    text = json.dumps({k: P[k] for k in keys}, sort_keys=True) + ' v%d' % CACHE_VERSION
+    return 'oedo_n%d_%s' % (P['num_spheres'], hashlib.sha256(text.encode()).hexdigest()[:12])
+
+
+def wall_y(i):
+    return O.bodies[i].state.pos[1]
+
+
+def height():
+    return wall_y(TOP) - wall_y(BOTTOM)
+
+
+def area():
+    return (O.bodies[XMAX].state.pos[0] - O.bodies[XMIN].state.pos[0]) * \
+           (O.bodies[ZMAX].state.pos[2] - O.bodies[ZMIN].state.pos[2])
+
+
+def top_stress():
+    """Compressive vertical stress the top wall receives (contacts + fluid), >0 [Pa]."""
+    return -O.forces.f(TOP)[1] / area()
+
+
+def bottom_stress():
+    """Compressive vertical stress on the bottom wall (contacts + fluid), >0 [Pa]."""
+    return O.forces.f(BOTTOM)[1] / area()
+
+
+def dem_engines(triax, newton):
+    return [ForceResetter(),
+            InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
+            InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
+                            [Law2_ScGeom_FrictPhys_CundallStrack()], label='iloop'),
+            GlobalStiffnessTimeStepper(active=1, timeStepUpdateInterval=100, timestepSafetyCoefficient=0.8),
+            triax, newton]
+
+
+def settle(triax, goal, P, tol=0.005, unb=0.01, chunk=200, max_iter=400000):
+    """Servo the top wall to vertical stress `goal` (dry, damped) until stress and unbalanced force settle."""
+    triax.goal2 = -goal
+    start = O.iter
+    while True:
+        O.run(chunk, True)
+        if abs(top_stress() - goal) < tol * P['small_load'] and utils.unbalancedForce() < unb:
+            # the wall stress can pass through the goal while the packing still moves: confirm on a second chunk
+            h = height()
+            O.run(chunk, True)
+            if abs(height() - h) < 1e-3 * P['small_load'] / P['young'] * h and abs(top_stress() - goal) < tol * P['small_load']:
+                return
+        if O.iter - start > max_iter:
+            raise RuntimeError('oedometer: the dry sample did not settle at %g Pa in %d iterations' % (goal, max_iter))
+
+
+def prepare(P):
+    """Dense packing + dry oedometric cycle; saved once, then reloaded bit for bit by every run."""
+    d = cache_dir()
+    base = os.path.join(d, prep_key(P))
+    state, meta_path = base + '.bin.gz', base + '.json'
+    if os.path.exists(state) and os.path.exists(meta_path):
+        with open(meta_path) as f:
+            meta = json.load(f)
+        log('prepared sample read from %s (E_oed = %.4g Pa, porosity %.4f)' % (state, meta['E_oed'], meta['porosity']))
+        O.load(state)
+        return meta
+    t0 = time.time()
+    log('preparing the sample (%d spheres), cached as %s' % (P['num_spheres'], state))
+    O.reset()
+    L = P['box']
+    O.materials.append(FrictMat(young=P['young'], poisson=P['poisson'], frictionAngle=math.radians(P['compaction_friction']),
+                                density=P['density'], label='spheres'))
+    O.materials.append(FrictMat(young=P['young'], poisson=P['poisson'], frictionAngle=0, density=0, label='walls'))
+    walls = O.bodies.append(utils.aabbWalls([(0, 0, 0), (L, L, L)], thickness=0, material='walls'))
+    assert walls == list(range(6))
+    sp = pack.SpherePack()
+    sp.makeCloud((0, 0, 0), (L, L, L), -1, P['rRelFuzz'], P['num_spheres'], False, 0.95, seed=P['seed'])
+    sp.toSimulation(material='spheres')
+    young = P['young']
+    triax = TriaxialStressController(maxMultiplier=1. + 2e4 / young, finalMaxMultiplier=1. + 2e3 / young, thickness=0,
+                                     stressMask=7, max_vel=0.005 * L, internalCompaction=True, label='triax')
+    newton = NewtonIntegrator(damping=P['dry_damping'], label='newton')
+    O.engines = dem_engines(triax, newton)
+    for e in O.engines:  # one thread: the prepared sample must not depend on yade -jN
+        e.ompThreads = 1
+    triax.goal1 = triax.goal2 = triax.goal3 = -P['sigma0']
+    while True:  # isotropic compaction by particle growth
+        O.run(500, True)
+        if utils.unbalancedForce() < 0.005 and abs(P['sigma0'] + triax.meanStress) / P['sigma0'] < 0.005:
+            break
+        if O.iter > 500000:
+            raise RuntimeError('oedometer: compaction did not converge')
+    log('compacted in %d iterations, porosity %.4f' % (O.iter, triax.porosity))
+    utils.setContactFriction(math.radians(P['friction']))
+    O.materials[0].frictionAngle = math.radians(P['friction'])
+    # oedometric conditions: lateral walls fixed (zero strain rate), bottom fixed, top wall stress-controlled
+    triax.internalCompaction = False
+    triax.stressMask = 2
+    triax.goal1 = triax.goal3 = 0
+    triax.wall_bottom_activated = False
+    s0, ds = P['sigma0'], P['small_load']
+    settle(triax, s0, P)
+    h = [height()]
+    for goal in (s0 + ds, s0, s0 + ds, s0):  # load, unload, reload, unload
+        settle(triax, goal, P)
+        h.append(height())
+    eps = [(h[0] - h[1]) / h[0], (h[2] - h[3]) / h[2], (h[4] - h[3]) / h[2]]  # first load, reload, second unload
+    E_oed = ds / eps[1]
+    meta = dict(E_oed=E_oed, eps_first_load=eps[0], eps_reload=eps[1], eps_unload=eps[2],
+                E_oed_first_load=ds / eps[0], height=height(), area=area(), porosity=triax.porosity,
+                iterations=O.iter, prepare_seconds=time.time() - t0, key=prep_key(P))
+    log('dry cycle: strains first load %.4g, reload %.4g, unload %.4g -> E_oed = %.4g Pa (first load %.4g)'
+        % (eps[0], eps[1], eps[2], E_oed, ds / eps[0]))
+    os.makedirs(d, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=d, prefix='.tmp-', suffix='.bin.gz')
+    os.close(fd)
+    O.save(tmp)
+    os.replace(tmp, state)
+    with open(meta_path + '.tmp', 'w') as f:
+        json.dump(meta, f, indent=1)
+    os.replace(meta_path + '.tmp', meta_path)
+    O.load(state)  # continue from the saved state exactly as a cached run would
+    return meta
+
+
+def dry_nonlinear(P, meta):
+    """Dry oedometric loading by the nonlinear load on a copy of the prepared sample: secant modulus."""
+    key = 'dry_eps_%g' % P['load']
+    if key in meta:
+        return meta[key]
+    triax, newton = find_engine(TriaxialStressController), find_engine(NewtonIntegrator)
+    h0 = height()
+    settle(triax, P['sigma0'] + P['load'], P, tol=0.002 * P['load'] / P['small_load'])
+    eps = (h0 - height()) / h0
+    meta[key] = eps
+    meta_path = os.path.join(cache_dir(), prep_key(P) + '.json')
+    with open(meta_path + '.tmp', 'w') as f:
+        json.dump(meta, f, indent=1)
+    os.replace(meta_path + '.tmp', meta_path)
+    log('dry nonlinear loading: strain %.4g under %g Pa -> secant E_oed = %.4g Pa' % (eps, P['load'], P['load'] / eps))
+    O.load(os.path.join(cache_dir(), prep_key(P) + '.bin.gz'))
+    return eps
+
+
+def find_engine(cls):
+    return [e for e in O.engines if isinstance(e, cls)][0]
+
+
+# ---------------------------------------------------------------- coupled phase -----------------------------
+def make_flow(engine):
+    if engine == 'pfv':
+        from pfv import FlowEngine
+    else:
+        from yade.wrapper import FlowEngine
+    return FlowEngine(label='flow')
+
+
+def viscous_time_step(mu):
+    """dt_MV = pi rho d^2 / (1200 mu) = m / (200 mu d) at the smallest value over the dynamic spheres."""
+    return min(b.state.mass / (2 * b.shape.radius) for b in O.bodies if isinstance(b.shape, Sphere) and b.dynamic) \
+        / (200 * mu)
+
+
+def slice_pressure(flow, y, n):
+    """Mean pore pressure over an n x n grid of the horizontal slice at height y (same for both engines)."""
+    x0, x1 = O.bodies[XMIN].state.pos[0], O.bodies[XMAX].state.pos[0]
+    z0, z1 = O.bodies[ZMIN].state.pos[2], O.bodies[ZMAX].state.pos[2]
+    s = 0.0
+    for i in range(n):
+        for j in range(n):
+            s += flow.getPorePressure((x0 + (i + 0.5) / n * (x1 - x0), y, z0 + (j + 0.5) / n * (z1 - z0)))
+    return s / (n * n)
+
+
+def permeameter(flow, P):
+    """One flow step with dp on the bottom and 0 on the top: K = Q gamma_w H / (A dp)."""
+    flow.bndCondIsPressure = [False, False, True, True, False, False]
+    flow.bndCondValue = [0, 0, P['perm_dp'], 0, 0, 0]
+    flow.updateTriangulation = True
+    O.run(1, True)
+    q_in, q_out = flow.getBoundaryFlux(BOTTOM), flow.getBoundaryFlux(TOP)
+    K = 0.5 * (abs(q_in) + abs(q_out)) * P['gamma_w'] * height() / (area() * P['perm_dp'])
+    log('permeameter: Qin %.6g Qout %.6g -> K = %.6g m/s (mu = %g Pa.s)' % (q_in, q_out, K, P['viscosity']))
+    return K, q_in, q_out
+
+
+def run(opts):
+    P = parameters(opts)
+    tag = opts['engine'] + ('-quick' if opts['quick'] else '') + ('-nonlinear' if opts['nonlinear'] else '') + \
+        ('-both' if P['drainage'] == 'both' else '')
+    out = opts['out'] or os.path.abspath('oedometer-' + tag)
+    os.makedirs(out, exist_ok=True)
+    wall0 = time.time()
+    meta = prepare(P)
+    dry_eps = P['small_load'] / meta['E_oed'] if not opts['nonlinear'] else dry_nonlinear(P, meta)
+
+    # --- switch the fluid on -------------------------------------------------------------------------------
+    triax, newton = find_engine(TriaxialStressController), find_engine(NewtonIntegrator)
+    flow = make_flow(opts['engine'])
+    O.engines = [e for e in O.engines if not isinstance(e, (GlobalStiffnessTimeStepper, TriaxialStressController,
+                                                            NewtonIntegrator))] + [flow, triax, newton]
+    flow.viscosity = P['viscosity']
+    flow.boundaryUseMaxMin = [False] * 6  # the pore space is bounded by the wall bodies
+    flow.meshUpdateInterval = P['mesh_update_interval']
+    flow.useSolver = 3
+    newton.damping = 0.0  # the fluid damps (thesis)
+    dt_mv = viscous_time_step(P['viscosity'])
+    dt_dem = utils.PWaveTimeStep()
+    O.dt = P['zeta'] * min(dt_mv, dt_dem)
+    log('time step: dt_MV %.4g s, P-wave %.4g s -> O.dt = %.4g s' % (dt_mv, dt_dem, O.dt))
+    if opts['engine'] == 'pfv':
+        assert abs(flow.viscous_time_step / dt_mv - 1) < 1e-9, (flow.viscous_time_step, dt_mv)
+    K0, q_in, q_out = permeameter(flow, P)
+    H0, A = height(), area()
+    E_oed = meta['E_oed'] if not opts['nonlinear'] else meta['E_oed']
+    Cv = K0 * E_oed / P['gamma_w']
+    L_drain = H0 if P['drainage'] == 'top' else H0 / 2
+    t_c = L_drain ** 2 / Cv
+    c_wave = math.sqrt(E_oed / (P['density'] * (1 - meta['porosity'])))
+    log('C_v = %.5g m2/s, drainage length %.5g m, t(T_v=1) = %.5g s = %d steps; t_c / t_wave = %.1f'
+        % (Cv, L_drain, t_c, round(t_c / O.dt), t_c / (H0 / c_wave)))
+
+    # --- consolidation -------------------------------------------------------------------------------------
+    flow.bndCondIsPressure = [False, False, P['drainage'] == 'both', True, False, False]
+    flow.bndCondValue = [0.0] * 6
+    flow.updateTriangulation = True  # YADE applies new boundary types at a remesh
+    sigma0 = top_stress()
+    triax.goal2 = -(P['sigma0'] + P['load'])
+    triax.max_vel = 1e3 * dry_eps * H0 / t_c  # do not let the wall speed limit the settlement
+    it0, t0 = O.iter, O.time
+    s_dry = dry_eps * H0
+    n = P['slice_grid']
+    rows, iso = [], []
+    targets = sorted(set(list(np.geomspace(1e-3, P['Tv_end'], 60)) + list(P['isochrones'])))
+    targets = [T for T in targets if T <= P['Tv_end'] * (1 + 1e-9)]
+    iso_left = [T for T in P['isochrones'] if T <= P['Tv_end'] * (1 + 1e-9)]
+    if not HEADLESS:
+        from yade import plot
+        plot.plots = {'Tv': ('U_sim', 'U_theory'), 'Tv ': ('p_mid', 'p_mid_theory')}
+        plot.plot(subPlots=True)
+    wall_flow = 0.0
+    for T in targets:
+        steps = max(1, int(math.ceil((t0 + T * t_c - O.time) / O.dt)))
+        t_run = time.time()
+        O.run(steps, True)
+        wall_flow += time.time() - t_run
+        Tv = (O.time - t0) / t_c
+        H = height()
+        s = H0 - H
+        p_mid = slice_pressure(flow, wall_y(BOTTOM) + 0.5 * H, n)
+        zeta_mid = 0.5 if P['drainage'] == 'both' else 0.5
+        p_mid_th = P['load'] * terzaghi_p([zeta_mid], Tv)[0]
+        row = dict(iter=O.iter - it0, t=O.time - t0, Tv=Tv, height=H, settlement=s, U_sim=s / s_dry,
+                   U_theory=float(terzaghi_U(Tv)[0]), p_mid=p_mid, p_mid_theory=p_mid_th,
+                   sigma_top=top_stress(), sigma_bottom_total=bottom_stress(),
+                   bottom_fluid_stress=flow.fluidForce(BOTTOM)[1] / A, kinetic_energy=utils.kineticEnergy())
+        rows.append(row)
+        if not HEADLESS:
+            plot.addData(Tv=Tv, U_sim=row['U_sim'], U_theory=row['U_theory'], p_mid=p_mid / P['load'],
+                         p_mid_theory=p_mid_th / P['load'])
+        if iso_left and Tv >= iso_left[0] * (1 - 1e-9):
+            T_iso = iso_left.pop(0)
+            for i in range(P['profile_points']):
+                rel = (i + 0.5) / P['profile_points']  # height from the bottom / H
+                zeta = (1 - rel) if P['drainage'] == 'top' else 2 * rel  # distance from a drained face / L
+                if P['drainage'] == 'both' and rel > 0.5:
+                    zeta = 2 * (1 - rel)
+                p = slice_pressure(flow, wall_y(BOTTOM) + rel * H, n)
+                iso.append(dict(Tv_target=T_iso, Tv=Tv, z_over_H=rel, p_over_load=p / P['load'],
+                                p_theory_over_load=float(terzaghi_p([zeta], Tv)[0])))
+        if len(rows) % 10 == 0 or T == targets[-1]:
+            log('T_v %.4f  U_sim %.4f  U_th %.4f  p_mid/load %.4f (th %.4f)  bottom total %.5g Pa'
+                % (Tv, row['U_sim'], row['U_theory'], p_mid / P['load'], p_mid_th / P['load'], row['sigma_bottom_total']))
+
+    # --- errors --------------------------------------------------------------------------------------------
+    U_err = max(abs(r['U_sim'] - r['U_theory']) for r in rows)
+    iso_rms = math.sqrt(sum((r['p_over_load'] - r['p_theory_over_load']) ** 2 for r in iso) / len(iso)) if iso else float('nan')
+    mid_rms = math.sqrt(sum(((r['p_mid'] - r['p_mid_theory']) / P['load']) ** 2 for r in rows) / len(rows))
+    load_total = P['sigma0'] + P['load']
+    early = [r for r in rows if r['Tv'] >= 0.01]
+    bottom_err = max(abs(r['sigma_bottom_total'] - load_total) for r in early) / P['load']
+    summary = dict(engine=opts['engine'], quick=opts['quick'], nonlinear=opts['nonlinear'], drainage=P['drainage'],
+                   parameters={k: v for k, v in P.items()}, prepared=meta, dt=O.dt, dt_MV=dt_mv, dt_DEM=dt_dem,
+                   K=K0, Qin=q_in, Qout=q_out, E_oed=E_oed, Cv=Cv, H0=H0, area=A, drainage_length=L_drain,
+                   t_Tv1=t_c, sigma_top_start=sigma0, dry_settlement=s_dry, steps=O.iter - it0,
+                   final_U=rows[-1]['U_sim'], U_max_abs_error=U_err, isochrone_rms_error=iso_rms,
+                   mid_pressure_rms_error=mid_rms, max_p_mid_over_load=max(r['p_mid'] for r in rows) / P['load'],
+                   bottom_total_stress_max_error=bottom_err, coupled_wall_seconds=wall_flow)
+    if opts['engine'] == 'pfv':
+        summary['remesh_count'] = flow.core.remesh_count()
+    if opts['nonlinear']:
+        K1, _, _ = permeameter(flow, P)
+        E_sec = P['load'] / dry_eps
+        Cv1 = K1 * E_sec / P['gamma_w']
+        L1 = height() if P['drainage'] == 'top' else height() / 2
+        for r in rows:
+            r['U_theory_final_Cv'] = float(terzaghi_U(Cv1 * r['t'] / L1 ** 2)[0])
+        summary.update(K_final=K1, E_oed_secant=E_sec, Cv_final=Cv1, dry_strain=dry_eps,
+                       U_max_abs_error_final_Cv=max(abs(r['U_sim'] - r['U_theory_final_Cv']) for r in rows),
+                       final_strain=(H0 - rows[-1]['height']) / H0)
+        log('nonlinear: K_init %.5g K_final %.5g m/s, E_oed init %.5g secant %.5g Pa, C_v init %.5g final %.5g m2/s'
+            % (K0, K1, E_oed, E_sec, Cv, Cv1))
+        log('nonlinear: max |U_sim - U_theory| with C_v,init %.4f, with C_v,final %.4f'
+            % (U_err, summary['U_max_abs_error_final_Cv']))
+    summary['total_wall_seconds'] = time.time() - wall0
+
+    write_csv(os.path.join(out, 'timeseries.csv'), rows)
+    write_csv(os.path.join(out, 'isochrones.csv'), iso)
+    with open(os.path.join(out, 'summary.json'), 'w') as f:
+        json.dump(summary, f, indent=1, default=float)
+    plot_runs([(opts['engine'], rows, iso, summary)], os.path.join(out, 'oedometer.png'))
+    log('engine %s: %d coupled steps in %.1f s (%.2f ms/step)' % (opts['engine'], O.iter - it0, wall_flow,
+                                                                   1e3 * wall_flow / max(1, O.iter - it0)))
+    log('RESULT engine=%s K=%.6g E_oed=%.6g Cv=%.6g max|U_sim-U_th|=%.4f isochrone_rms/load=%.4f mid_rms/load=%.4f '
+        'final_U=%.4f bottom_total_err/load=%.4f' % (opts['engine'], K0, E_oed, Cv, U_err, iso_rms, mid_rms,
+                                                   rows[-1]['U_sim'], bottom_err))
+    log('outputs in %s' % out)
+    return summary
+
+
+def write_csv(path, rows):
+    if not rows:
+        open(path, 'w').close()
+        return
+    keys = list(rows[0].keys())
+    with open(path, 'w') as f:
+        f.write(','.join(keys) + '\n')
+        for r in rows:
+            f.write(','.join(repr(float(r[k])) for k in keys) + '\n')
+
+
+def read_csv(path):
+    with open(path) as f:
+        keys = f.readline().strip().split(',')
+        return [dict(zip(keys, map(float, line.split(',')))) for line in f if line.strip()]
+
+
+# ---------------------------------------------------------------- plots -------------------------------------
+def plot_runs(runs, path):
+    """runs: [(label, timeseries rows, isochrone rows, summary)]; one PNG with U(T_v), p_mid(T_v), isochrones."""
+    import matplotlib
+    if HEADLESS:
+        matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(13, 4.2))
+    styles = ['o', 's', '^', 'v']
+    Tv = np.geomspace(1e-3, max(r[3]['parameters']['Tv_end'] for r in runs), 200)
+    ax[0].semilogx(Tv, terzaghi_U(Tv), 'k-', label='Terzaghi')
+    ax[1].semilogx(Tv, [terzaghi_p([0.5], T)[0] for T in Tv], 'k-', label='Terzaghi')
+    for k, (label, rows, iso, summ) in enumerate(runs):
+        m = styles[k % len(styles)]
+        lab = '%s (max err %.3f)' % (label, summ['U_max_abs_error'])
+        ax[0].semilogx([r['Tv'] for r in rows], [r['U_sim'] for r in rows], m, ms=3.5, mfc='none', label=lab)
+        if 'U_theory_final_Cv' in rows[0]:
+            ax[0].semilogx([r['Tv'] for r in rows], [r['U_theory_final_Cv'] for r in rows], '--',
+                           label='Terzaghi with C_v,final (%s)' % label)
+        ax[1].semilogx([r['Tv'] for r in rows], [r['p_mid'] / summ['parameters']['load'] for r in rows], m, ms=3.5,
+                       mfc='none', label='%s (RMS %.3f)' % (label, summ['mid_pressure_rms_error']))
+        for j, T in enumerate(sorted(set(r['Tv_target'] for r in iso))):
+            pts = [r for r in iso if r['Tv_target'] == T]
+            ax[2].plot([r['p_over_load'] for r in pts], [r['z_over_H'] for r in pts], m, ms=3.5, mfc='none',
+                       color='C%d' % j, label=('%s' % label) if j == 0 else None)
+            if k == 0:
+                zz = np.linspace(0, 1, 101)
+                drain = summ['drainage']
+                zeta = (1 - zz) if drain == 'top' else np.where(zz <= 0.5, 2 * zz, 2 * (1 - zz))
+                ax[2].plot(terzaghi_p(zeta, pts[0]['Tv']), zz, '-', color='C%d' % j, lw=1,
+                           label='T_v = %g' % T)
+    ax[0].set(xlabel='T_v', ylabel='U = settlement / dry settlement', title='Degree of consolidation')
+    ax[1].set(xlabel='T_v', ylabel='p / load at mid-height', title='Excess pore pressure, mid-height')
+    ax[2].set(xlabel='p / load', ylabel='height / H', title='Isochrones (lines: Terzaghi)')
+    for a in ax:
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    log('plot written to %s' % path)
+
+
+def compare(dirs, out):
+    runs = []
+    for d in dirs:
+        with open(os.path.join(d, 'summary.json')) as f:
+            s = json.load(f)
+        runs.append((s['engine'], read_csv(os.path.join(d, 'timeseries.csv')), read_csv(os.path.join(d, 'isochrones.csv')), s))
+    os.makedirs(out, exist_ok=True)
+    plot_runs(runs, os.path.join(out, 'oedometer-comparison.png'))
+    print('| engine | K [m/s] | E_oed [Pa] | C_v [m2/s] | steps | max abs(U_sim - U_th) | RMS isochrones / load | '
+          'RMS p_mid / load | final U |')
+    print('|---|---|---|---|---|---|---|---|---|')
+    for label, rows, iso, s in runs:
+        print('| %s | %.4g | %.4g | %.4g | %d | %.4f | %.4f | %.4f | %.4f |' % (
+            label, s['K'], s['E_oed'], s['Cv'], s['steps'], s['U_max_abs_error'], s['isochrone_rms_error'],
+            s['mid_pressure_rms_error'], s['final_U']))
+
+
+def main():
+    opts = parse_args([a for a in sys.argv[1:]])
+    if opts['compare']:
+        compare(opts['compare'], opts['out'] or '.')
+        return 0
+    run(opts)
+    return 0
+
+
+if __name__ in ('__main__', 'builtins') or True:
+    _status = main()
+    if HEADLESS:
+        sys.exit(_status)

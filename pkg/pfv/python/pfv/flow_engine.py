@@ -20,7 +20,7 @@ import yade
 from yade.wrapper import PyRunner, Sphere, Box
 from yade.minieigenHP import Vector3
 
-from ._core import Engine, set_num_threads
+from ._core import Engine, add_forces, set_num_threads
 from ._yade_api import ATTRIBUTES as _YADE_ATTRIBUTES, METHODS as _YADE_METHODS
 
 __all__ = ["FlowEngine", "TimeStepWarning"]
@@ -285,14 +285,13 @@ class FlowEngine(PyRunner):
                 warnings.warn(f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
                               f"regular triangulation and get no fluid force (ids {self._ids[hidden][:10].tolist()}...)",
                               stacklevel=2)
-        forces = core.forces().tolist()
+        forces = core.forces()
         add = O.forces.addF
-        for bid, f in zip(self._ids.tolist(), forces):
-            add(bid, f)
+        add_forces(add, self._ids, forces, 0)
         n = len(self._ids)
         for w, bid in enumerate(self._wall_ids):
             if self._wall_rows[w] >= 0:
-                add(bid, forces[n + w])
+                add(bid, tuple(forces[n + w]))
 
     @property
     def viscous_time_step(self):

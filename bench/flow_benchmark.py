@@ -60,6 +60,7 @@ STRESS = -1.0e4             # confining stress of the packings [Pa]
 YOUNG = 1.0e6
 OEDO_VISCOSITY = 10.0
 OEDO_LOAD = -1.1e4
+OEDO_DT = 1e-4
 AXIS = 1                    # flow along y
 
 
@@ -269,7 +270,9 @@ def build_scene(n, oedometer=False):
         engines.append(triax)
     engines.append(NewtonIntegrator(damping=0.0 if oedometer else 0.2, label='newton'))
     O.engines = engines
-    O.dt = 0.5 * utils.PWaveTimeStep()
+    # Oedometer: O.dt = 1e-4 as in YADE's example (viscosity 10: the explicit coupling is unstable at 0.5 P-wave
+    # step, about 9e-4, with either engine).
+    O.dt = OEDO_DT if oedometer else 0.5 * utils.PWaveTimeStep()
     O.dynDt = False
     O.run(20, True)   # contacts exist and the first collider pass is done before any measurement
     return dict(n=n, box=L, digest=packing_digest(spheres), meta=meta, dt=O.dt, bodies=len(O.bodies))
@@ -401,6 +404,8 @@ def run_trial(kind, info, steady, warnings_seen):
             O.step()
             wall.append(time.perf_counter() - t0)
         res['steady_wall'] = wall
+        res['vmax'] = max(b.state.vel.norm() for b in O.bodies)
+        O.reset()
         return res
 
     flow = make_engine(kind)
@@ -456,6 +461,7 @@ def run_trial(kind, info, steady, warnings_seen):
         res['td_steady'] = _td_diff(td1, td2)
         res['td_remesh'] = _td_diff(td2, td3)
     L = info['box']
+    res['vmax'] = max(b.state.vel.norm() for b in O.bodies)
     res['probes'] = [flow.getPorePressure(p) for p in probe_points(L)]
     res['flux'] = [flow.getBoundaryFlux(2 * AXIS), flow.getBoundaryFlux(2 * AXIS + 1)]
     res['core_timer'] = proxy is not None
@@ -591,7 +597,10 @@ def run_child(args, threads, label):
         os.remove(path)
     cmd = [exe, '-j%d' % threads, '-n', '-x', SCRIPT] + args + ['--child-json=%s' % path]
     t0 = time.time()
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=REPO)
+    # CHOLMOD's supernodal factorisation calls BLAS; Debian's OpenBLAS (pthread build) would otherwise use every
+    # core whatever yade's -jN: pin it to the thread count being measured, for both engines alike.
+    env = dict(os.environ, OPENBLAS_NUM_THREADS=str(threads), OMP_NUM_THREADS=str(threads))
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=REPO, env=env)
     tail = []
     for line in proc.stdout:
         line = line.rstrip('\n')
@@ -649,6 +658,7 @@ def machine_description():
         d['pfv module'] = 'IMPORT FAILED: %s' % e
     d['git'] = (sh('git -C %s rev-parse --short HEAD' % REPO) +
                 (' (working tree modified in lib/ pkg/)' if sh('git -C %s status --porcelain lib pkg CMakeLists.txt' % REPO) else ''))
+    d['BLAS'] = os.path.realpath('/usr/lib/x86_64-linux-gnu/libblas.so.3') + ' (children run with OPENBLAS_NUM_THREADS = OMP_NUM_THREADS = yade -jN)'
     d['load average at start'] = ' '.join('%.2f' % x for x in os.getloadavg())
     return d
 
@@ -677,6 +687,7 @@ def summarise(timing, memory):
             dry = [median(x['steady_wall']) for x in tr['dry']]
             row['dry'] = median(dry)
             row['dry_range'] = (min(dry), max(dry)) if dry else None
+            row['vmax'] = {k: max([x.get('vmax', float('nan')) for x in tr[k]] or [float('nan')]) for k in tr}
             for kind in ('yade', 'pfv'):
                 flow_step, remesh, first, coupled = [], [], [], []
                 for x in tr[kind]:
@@ -881,15 +892,17 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
         w('')
     w('### Pressure agreement (PFV vs YADE, same scene, same step)')
     w('')
-    w('| threads | N | max abs(dp) / dp over 27 probes | mean | Qin rel. diff | Qout rel. diff | p(centre) YADE | PFV |')
-    w('|---|---|---|---|---|---|---|---|')
+    w('| threads | N | max abs(dp) / dp over 27 probes | mean | Qin rel. diff | Qout rel. diff | p(centre) YADE | PFV '
+      '| max sphere speed dry / YADE / PFV |')
+    w('|---|---|---|---|---|---|---|---|---|')
     for t in sorted(summ, key=int):
         for ns in sorted(summ[t]['sizes'], key=int):
             a = summ[t]['sizes'][ns].get('agreement')
             if a:
-                w('| %s | %s | %.2e | %.2e | %.2e | %.2e | %.4g | %.4g |'
+                v = summ[t]['sizes'][ns]['vmax']
+                w('| %s | %s | %.2e | %.2e | %.2e | %.2e | %.4g | %.4g | %.2g / %.2g / %.2g m/s |'
                   % (t, ns, a['max_dp'], a['mean_dp'], a['flux_in_rel'], a['flux_out_rel'], a['probe_yade'],
-                     a['probe_pfv']))
+                     a['probe_pfv'], v['dry'], v['yade'], v['pfv']))
     w('')
     for t in sorted(summ, key=int):
         sizes = summ[t]['sizes']
@@ -1000,8 +1013,8 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
         w('### Coupled / dry cost on the oedometer-like scene')
         w('')
         w('Top wall driven by a TriaxialStressController (stressMask=2) from 10 to 11 kPa, drained top, viscosity %g, '
-          'Newton damping 0, meshUpdateInterval and defTolerance 0.3 as in YADE\'s oedometer example; wall-clock time '
-          'of O.run(M) per step, remeshing included.' % OEDO_VISCOSITY)
+          'Newton damping 0, O.dt = %g, meshUpdateInterval (below) and defTolerance 0.3 as in YADE\'s oedometer '
+          'example; wall-clock time of O.run(M) per step, remeshing included.' % (OEDO_VISCOSITY, OEDO_DT))
         w('')
         w('| threads | N | M steps | remesh interval | dry | YADE coupled | YADE coupled/dry | PFV coupled | PFV coupled/dry '
           '| PFV remeshes | p(0.1 H) YADE / PFV | settlement dry / YADE / PFV |')

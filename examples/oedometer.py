@@ -198,6 +198,8 @@ def settle(triax, goal, P, tol=0.005, unb=0.01, chunk=200, max_iter=400000):
     start = O.iter
     while True:
         O.run(chunk, True)
+        if os.environ.get('OEDO_DEBUG'):
+            log('settle %g: iter %d stress %.6g unb %.4g height %.8g dt %.3g' % (goal, O.iter, top_stress(), utils.unbalancedForce(), height(), O.dt))
         if abs(top_stress() - goal) < tol * P['small_load'] and utils.unbalancedForce() < unb:
             # the wall stress can pass through the goal while the packing still moves: confirm on a second chunk
             h = height()
@@ -246,6 +248,8 @@ def prepare(P):
         if O.iter > 500000:
             raise RuntimeError('oedometer: compaction did not converge')
     log('compacted in %d iterations, porosity %.4f' % (O.iter, triax.porosity))
+    if os.environ.get('OEDO_DEBUG'):
+        O.save('/tmp/oedo/compacted.bin.gz')
     utils.setContactFriction(math.radians(P['friction']))
     O.materials[0].frictionAngle = math.radians(P['friction'])
     # oedometric conditions: lateral walls fixed (zero strain rate), bottom fixed, top wall stress-controlled

@@ -28,7 +28,7 @@ struct EngineSettings {
   bool force_metis = false;  // YADE's forceMetis: METIS ordering whatever 'ordering' says
   Ordering ordering = Ordering::kAuto;
   int mesh_update_interval = 1000;
-  double def_tolerance = 0.05;
+  double def_tolerance = 0;  // YADE's default: no strain-triggered remesh
   double p_zero = 0;
 };
 
@@ -75,6 +75,7 @@ class FlowEngine {
   bool metis_used() const { return cholmod_->metis_used(); }
   const CholmodSolver& cholmod() const { return *cholmod_; }
   int remesh_count() const { return remesh_count_; }
+  double accumulated_strain() const { return strain_; }
   int gs_iterations() const { return gs_iterations_; }
   const StageTimes& remesh_times() const { return remesh_times_; }
   const StageTimes& step_times() const { return step_times_; }
@@ -101,6 +102,7 @@ class FlowEngine {
   BoxWalls walls_prev_;
   bool has_prev_ = false;
   double strain_ = 0;
+  double mean_cell_volume_ = 0;
   int steps_since_remesh_ = 0;
   int remesh_count_ = 0;
   int gs_iterations_ = 0;

@@ -229,6 +229,7 @@ PYBIND11_MODULE(_core, m) {
       .def("hidden_spheres", [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; })
       .def_property_readonly("remesh_count", &FlowEngine::remesh_count)
       .def_property_readonly("gs_iterations", &FlowEngine::gs_iterations)
+      .def_property_readonly("accumulated_strain", &FlowEngine::accumulated_strain)
       .def("walls", [](const FlowEngine& e) { return e.walls().coord; })
       .def("remesh_times", [](const FlowEngine& e) { return times_dict(e.remesh_times()); })
       .def("step_times", [](const FlowEngine& e) { return times_dict(e.step_times()); })

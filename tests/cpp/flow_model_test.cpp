@@ -176,3 +176,30 @@ TEST(FlowEngine, NoPressureBoundaryIsASingularSystem) {
     EXPECT_NE(std::string(err.what()).find("no boundary has an imposed pressure"), std::string::npos);
   }
 }
+
+TEST(FlowEngine, RemeshTriggers) {
+  auto p = test::random_packing(150, 30);
+  FlowEngine e = permeameter(0);
+  e.settings.mesh_update_interval = 3;
+  for (int i = 0; i < 7; ++i) e.step(p.centre, p.radius, p.walls, 1.0);
+  EXPECT_EQ(e.remesh_count(), 3);  // steps 1, 4 and 7
+
+  // Cumulative pore strain: each shrink changes pore volumes by a few per mille; the
+  // threshold is crossed after a few steps, not at every step and not never.
+  FlowEngine s = permeameter(0);
+  s.settings.mesh_update_interval = 0;
+  s.settings.def_tolerance = 0.02;
+  s.step(p.centre, p.radius, p.walls, 1.0);
+  int remeshes_seen = 1;
+  for (int i = 0; i < 12; ++i) {
+    for (auto& x : p.centre) x = Vec3(0.5, 0.5, 0.5) + 0.999 * (x - Vec3(0.5, 0.5, 0.5));
+    s.step(p.centre, p.radius, p.walls, 1.0);
+    remeshes_seen = s.remesh_count();
+  }
+  EXPECT_GT(remeshes_seen, 1);
+  EXPECT_LT(remeshes_seen, 12);
+
+  e.request_remesh();
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  EXPECT_EQ(e.remesh_count(), 4);
+}

@@ -249,6 +249,11 @@ FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells
       sector[poly.slot[r]] = 0.5 * planar_angle(poly.edge[r][0], poly.edge[r][1]) * rad * rad;
       sectors += sector[poly.slot[r]];
     }
+    // Sectors can exceed the facet where a sphere reaches across it (overlaps, spheres cutting
+    // a wall). The facet is then all solid: scale the sectors so that solid + fluid is still the
+    // facet area, which keeps every cell a closed surface and the force balance exact.
+    if (sectors > area && sectors > 0)
+      for (double& a : sector) a *= area / sectors;
     g.sector_area[f] = sector;
     g.fluid_area[f] = std::max(0.0, area - sectors);
 

@@ -43,7 +43,7 @@ struct FacetGeometry {
   std::vector<double> fluid_area;
   std::vector<double> length;              // |P_0 P_1|; 0 for a one-sided facet
   std::vector<double> hydraulic_radius;
-  std::vector<std::array<double, 3>> sector_area;  // A^k
+  std::vector<std::array<double, 3>> sector_area;  // A^k, scaled down if they exceed the facet
   std::vector<std::array<double, 3>> wetted_area;  // gamma^k
 
   int size() const { return static_cast<int>(cell.size()); }

@@ -189,11 +189,14 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     rebuild_system();  // new boundary conditions, or switched from Gauss-Seidel to CHOLMOD
   }
 
+  // Everything below writes into scratch buffers; the engine's state changes only once the
+  // step has produced finite pressures and forces.
   auto t0 = Clock::now();
   const int nc = mesh().n_cells();
   // Pore strain of the step, max over cells (thesis 5.13). A near-flat cell would make any
   // motion look like a huge strain, so volumes below the mean count as the mean.
   double max_change = 0;
+  next_volume_.resize(nc);
   volume_rate_.resize(nc);
 #pragma omp parallel for schedule(static) reduction(max : max_change)
   for (int c = 0; c < nc; ++c) {
@@ -201,13 +204,13 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     const double dv = has_prev_ ? v - volume_[c] : 0.0;
     volume_rate_[c] = dv / dt;
     max_change = std::max(max_change, std::abs(dv) / std::max(v, mean_cell_volume_));
-    volume_[c] = v;
+    next_volume_[c] = v;
   }
-  const double max_strain = max_change;
   step_times_.volumes = seconds_since(t0);
 
   t0 = Clock::now();
-  apply_dirichlet_values(system_, bc, pressure_);
+  next_pressure_ = pressure_;  // Gauss-Seidel warm start
+  apply_dirichlet_values(system_, bc, next_pressure_);
   const int nu = system_.n_unknowns();
   rhs_.resize(nu);
   for (int u = 0; u < nu; ++u) rhs_[u] = -volume_rate_[system_.unknown_cell[u]];
@@ -218,21 +221,32 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   if (nu == 0) {
     // every cell has an imposed pressure: nothing to solve
   } else if (settings.use_solver == 0) {
-    const auto r = gauss_seidel(system_, rhs_, pressure_, settings.tolerance, settings.relax, settings.max_gs_iterations);
+    const auto r = gauss_seidel(system_, rhs_, next_pressure_, settings.tolerance, settings.relax, settings.max_gs_iterations);
     gs_iterations_ = r.iterations;
   } else {
     for (std::size_t i = 0; i < dirichlet_coupling_.size(); ++i)
-      rhs_[static_cast<int>(dirichlet_coupling_[i][0])] += dirichlet_coupling_[i][1] * pressure_[dirichlet_coupling_cell_[i]];
+      rhs_[static_cast<int>(dirichlet_coupling_[i][0])] += dirichlet_coupling_[i][1] * next_pressure_[dirichlet_coupling_cell_[i]];
     cholmod_->solve(rhs_, solution_);
-    for (int u = 0; u < nu; ++u) pressure_[system_.unknown_cell[u]] = solution_[u];
+    for (int u = 0; u < nu; ++u) next_pressure_[system_.unknown_cell[u]] = solution_[u];
   }
   step_times_.solve = seconds_since(t0);
 
   t0 = Clock::now();
-  cache_.apply(pressure_, force_);
+  cache_.apply(next_pressure_, next_force_);
   step_times_.forces = seconds_since(t0);
 
-  strain_ += max_strain;
+  // Never hand NaN or infinite forces back to the DEM.
+  const auto bad_p = std::find_if(next_pressure_.begin(), next_pressure_.end(), [](double x) { return !std::isfinite(x); });
+  if (bad_p != next_pressure_.end())
+    throw std::domain_error("non-finite pore pressure in cell " + std::to_string(bad_p - next_pressure_.begin()) +
+                            " (check boundary values, imposed fluxes and the time step)");
+  for (std::size_t v = 0; v < next_force_.size(); ++v)
+    if (!next_force_[v].allFinite()) throw std::domain_error("non-finite fluid force on vertex " + std::to_string(v));
+
+  std::swap(volume_, next_volume_);
+  std::swap(pressure_, next_pressure_);
+  std::swap(force_, next_force_);
+  strain_ += max_change;
   ++steps_since_remesh_;
   centres_prev_ = centres;
   walls_prev_ = walls;

@@ -98,6 +98,8 @@ class FlowEngine {
 
   std::vector<double> pressure_, volume_, volume_rate_, rhs_, solution_;
   std::vector<Vec3> force_;
+  std::vector<double> next_volume_, next_pressure_;  // scratch of the step being computed
+  std::vector<Vec3> next_force_;
   std::vector<Vec3> centres_prev_;
   BoxWalls walls_prev_;
   bool has_prev_ = false;

@@ -182,7 +182,7 @@ CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& pk) {
   g.volume.resize(n);
   g.fluid_volume.resize(n);
   g.power_centre.resize(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > kMinParallelLoop)
   for (int i = 0; i < n; ++i) {
     const CellShape s = make_cell_shape(mesh, i);
     g.shape[i] = s;
@@ -230,7 +230,7 @@ FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells
   g.sector_area.resize(nf);
   g.wetted_area.resize(nf);
 
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nf > kMinParallelLoop)
   for (int f = 0; f < nf; ++f) {
     const int i = g.cell[f][0], j = g.cell[f][1];
     const auto v = facet_vertices(mesh, i, g.local[f][0]);

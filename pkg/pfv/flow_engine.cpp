@@ -198,7 +198,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   double max_change = 0;
   next_volume_.resize(nc);
   volume_rate_.resize(nc);
-#pragma omp parallel for schedule(static) reduction(max : max_change)
+#pragma omp parallel for schedule(static) reduction(max : max_change) if (nc > kMinParallelLoop)
   for (int c = 0; c < nc; ++c) {
     const double v = cell_volume(cells_.shape[c], centres, walls);
     const double dv = has_prev_ ? v - volume_[c] : 0.0;

@@ -7,7 +7,7 @@ namespace pfv {
 void ForceCache::build(const Mesh& mesh, const FacetGeometry& facets, const Packing& packing) {
   const int nc = mesh.n_cells();
   std::vector<std::array<Vec3, 4>> per_cell(nc);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc > kMinParallelLoop)
   for (int c = 0; c < nc; ++c) per_cell[c] = wall_footprints(mesh, c, packing);
 
   for (int f = 0; f < facets.size(); ++f) {
@@ -58,7 +58,7 @@ void ForceCache::build(const Mesh& mesh, const FacetGeometry& facets, const Pack
 void ForceCache::apply(const std::vector<double>& p, std::vector<Vec3>& force) const {
   const int nv = n_vertices();
   force.resize(nv);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nv > kMinParallelLoop)
   for (int v = 0; v < nv; ++v) {
     Vec3 f = Vec3::Zero();
     for (int e = start_[v]; e < start_[v + 1]; ++e) f += p[cell_[e]] * unit_[e];

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "gauss_seidel_solver.hpp"
+#include "pore_mesh.hpp"
 
 namespace pfv {
 namespace {
@@ -47,124 +48,42 @@ void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<doubl
   }
 }
 
+FlowEngine::~FlowEngine() {
+  if (pending_) pending_->result.wait();  // the worker reads copies only, but let it finish
+}
+
 bool FlowEngine::remesh_due() const {
   return remesh_requested_ || !has_mesh() ||
          (settings.mesh_update_interval > 0 && steps_since_remesh_ >= settings.mesh_update_interval) ||
          (settings.def_tolerance > 0 && strain_ >= settings.def_tolerance);
 }
 
-void FlowEngine::remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                        const BoxWalls& walls) {
-  // Coincident centres make the triangulation drop a sphere silently: refuse them.
-  std::vector<int> order(centres.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return std::lexicographical_compare(centres[a].data(), centres[a].data() + 3, centres[b].data(), centres[b].data() + 3);
-  });
-  for (std::size_t i = 1; i < order.size(); ++i)
-    if (centres[order[i]] == centres[order[i - 1]])
-      bad_input("sphere " + std::to_string(order[i - 1]) + " and sphere " + std::to_string(order[i]) +
-                " have coincident centres " + describe(centres[order[i]]));
-
-  StageTimes t;
-  auto t0 = Clock::now();
-  RegularTriangulation tri;
-  const Mesh& mesh = tri.build(centres, radii, walls);
-  const auto inside = tri.centres_inside_neighbours(centres, radii);
-  if (!inside.empty())
-    bad_input("sphere " + std::to_string(inside[0].first) + " and sphere " + std::to_string(inside[0].second) +
-              " overlap so much that one centre lies inside the other sphere (" +
-              std::to_string(inside.size()) + " such pairs); the pore mesh would be degenerate");
-  if (mesh.n_cells() == 0) bad_input("the triangulation has no pore cell");
-  t.triangulation = seconds_since(t0);
-
-  t0 = Clock::now();
-  const Packing packing{centres, radii, walls};
-  CellGeometry cells = compute_cell_geometry(mesh, packing);
-  FacetGeometry facets = compute_facet_geometry(mesh, cells, packing, settings.slip_boundary);
-  t.geometry = seconds_since(t0);
-
-  t0 = Clock::now();
-  std::vector<double> k = throat_conductances(facets, settings.conductance);
-  t.conductance = seconds_since(t0);
-
-  t0 = Clock::now();
-  ForceCache cache;
-  cache.build(mesh, facets, packing);
-  t.force_cache = seconds_since(t0);
-
+void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, int bc_version) {
   // Warm start for Gauss-Seidel: the old pressure at the new pore centres.
-  std::vector<double> pressure(mesh.n_cells(), settings.p_zero);
+  std::vector<double> pressure(mesh.mesh().n_cells(), settings.p_zero);
   if (settings.use_solver == 0 && has_mesh())
-    for (int c = 0; c < mesh.n_cells(); ++c) {
-      const int old = tri_.locate(cells.power_centre[c]);
+    for (int c = 0; c < mesh.mesh().n_cells(); ++c) {
+      const int old = mesh_->tri.locate(mesh.cells.power_centre[c]);
       if (old >= 0) pressure[c] = pressure_[old];
     }
-
-  // Everything that can fail is done; commit (the system is rebuilt below from these).
-  RegularTriangulation old_tri = std::move(tri_);
-  tri_ = std::move(tri);
-  std::swap(cells_, cells);
-  std::swap(facets_, facets);
-  std::swap(k_, k);
-  try {
-    rebuild_system();
-  } catch (...) {
-    tri_ = std::move(old_tri);
-    std::swap(cells_, cells);
-    std::swap(facets_, facets);
-    std::swap(k_, k);
-    throw;
-  }
-  cache_ = std::move(cache);
-  pressure_ = std::move(pressure);
-  volume_.assign(cells_.volume.begin(), cells_.volume.end());
-  mean_cell_volume_ = std::accumulate(volume_.begin(), volume_.end(), 0.0) / std::max<std::size_t>(1, volume_.size());
-  volume_rate_.assign(mesh.n_cells(), 0.0);
-  t.assembly = remesh_times_.assembly;
-  t.analysis = remesh_times_.analysis;
-  t.factorization = remesh_times_.factorization;
+  StageTimes t = mesh.times;
+  t.assembly = linear.times.assembly;
+  t.analysis = linear.times.analysis;
+  t.factorization = linear.times.factorization;
   remesh_times_ = t;
-  strain_ = 0;
-  steps_since_remesh_ = 0;
-  remesh_requested_ = false;
+  mesh_ = std::make_unique<PoreMesh>(std::move(mesh));
+  linear_ = std::move(linear);
+  linear_bc_version_ = bc_version;
+  pressure_ = std::move(pressure);
+  const int nc = mesh_->mesh().n_cells();
+  volume_.assign(mesh_->cells.volume.begin(), mesh_->cells.volume.end());
+  volume_rate_.assign(nc, 0.0);
+  // Previous volumes on the new cells, so that dV/dt stays an exact backward difference.
+  if (has_prev_ && centres_prev_.size() == static_cast<std::size_t>(mesh_->mesh().n_spheres))
+    for (int c = 0; c < nc; ++c) volume_[c] = cell_volume(mesh_->cells.shape[c], centres_prev_, walls_prev_);
+  else
+    has_prev_ = false;  // bodies appeared or vanished: no backward difference this step
   ++remesh_count_;
-}
-
-void FlowEngine::rebuild_system() {
-  const Mesh& mesh = tri_.mesh();
-  std::vector<int> imposed_p(bc.imposed_pressure.size()), imposed_q(bc.imposed_flux.size());
-  for (std::size_t i = 0; i < imposed_p.size(); ++i) imposed_p[i] = tri_.locate(bc.imposed_pressure[i].position);
-  for (std::size_t i = 0; i < imposed_q.size(); ++i) imposed_q[i] = tri_.locate(bc.imposed_flux[i].position);
-
-  auto t0 = Clock::now();
-  PressureSystem system = assemble_pressure_system(mesh, facets_, k_, bc, imposed_p);
-  std::vector<std::array<double, 2>> coupling;
-  std::vector<int> coupling_cell;
-  for (int u = 0; u < system.n_unknowns(); ++u) {
-    const int c = system.unknown_cell[u];
-    for (int e = system.adj_start[c]; e < system.adj_start[c + 1]; ++e)
-      if (system.unknown[system.adj_cell[e]] < 0) {
-        coupling.push_back({static_cast<double>(u), system.adj_k[e]});
-        coupling_cell.push_back(system.adj_cell[e]);
-      }
-  }
-  remesh_times_.assembly = seconds_since(t0);
-
-  t0 = Clock::now();
-  auto solver = std::make_unique<CholmodSolver>();
-  if (settings.use_solver != 0)
-    solver->factorize(system, settings.force_metis ? Ordering::kMetis : settings.ordering);
-  remesh_times_.analysis = solver->analysis_seconds();
-  remesh_times_.factorization = seconds_since(t0) - remesh_times_.analysis;
-
-  system_ = std::move(system);
-  dirichlet_coupling_ = std::move(coupling);
-  dirichlet_coupling_cell_ = std::move(coupling_cell);
-  cholmod_ = std::move(solver);
-  imposed_pressure_cells_ = std::move(imposed_p);
-  imposed_flux_cells_ = std::move(imposed_q);
-  bc_dirty_ = false;
 }
 
 void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double>& radii,
@@ -179,14 +98,49 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   validate_snapshot(centres, radii, walls);
 
   const bool same_spheres = has_mesh() && centres.size() == static_cast<std::size_t>(mesh().n_spheres);
-  if (remesh_due() || !same_spheres) {
-    remesh(centres, radii, walls);
-    has_prev_ = has_prev_ && same_spheres;  // bodies appeared or vanished: no backward difference
-    if (has_prev_) {  // previous volumes on the new topology, for an exact backward difference
-      for (int c = 0; c < mesh().n_cells(); ++c) volume_[c] = cell_volume(cells_.shape[c], centres_prev_, walls_prev_);
+  if (pending_ && (!same_spheres || remesh_requested_)) {
+    pending_->result.wait();  // superseded: its snapshot is out of date
+    pending_.reset();
+  }
+  if (pending_ && pending_->result.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    const int version = pending_->bc_version;
+    auto future = std::move(pending_->result);
+    pending_.reset();
+    std::optional<Remesh> r;
+    try {
+      r.emplace(future.get());
+    } catch (...) {
+      remesh_requested_ = true;  // the next step remeshes in the foreground and says why
+      throw;
     }
-  } else if (bc_dirty_ || (settings.use_solver != 0 && system_.n_unknowns() > 0 && !cholmod_->ready())) {
-    rebuild_system();  // new boundary conditions, or switched from Gauss-Seidel to CHOLMOD
+    adopt(std::move(r->first), std::move(r->second), version);
+  }
+  if (!same_spheres || remesh_requested_ || (remesh_due() && !pending_)) {
+    if (settings.background_remesh && same_spheres && !remesh_requested_) {
+      // Snapshot now, build on another thread, carry on with the current mesh meanwhile.
+      pending_ = Pending{std::async(std::launch::async,
+                                    [c = centres, r = radii, w = walls, s = settings, b = bc]() {
+                                      PoreMesh m = build_pore_mesh(c, r, w, s);
+                                      LinearSystem l = build_linear_system(m, b, s);
+                                      return Remesh(std::move(m), std::move(l));
+                                    }),
+                         bc_version_};
+      strain_ = 0;
+      steps_since_remesh_ = 0;
+    } else {
+      PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
+      LinearSystem l = build_linear_system(m, bc, settings);
+      adopt(std::move(m), std::move(l), bc_version_);
+      strain_ = 0;
+      steps_since_remesh_ = 0;
+      remesh_requested_ = false;
+    }
+  }
+  if (linear_bc_version_ != bc_version_ ||
+      (settings.use_solver != 0 && linear_.system.n_unknowns() > 0 && !linear_.cholmod->ready())) {
+    // New boundary conditions, or switched from Gauss-Seidel to CHOLMOD.
+    linear_ = build_linear_system(*mesh_, bc, settings);
+    linear_bc_version_ = bc_version_;
   }
 
   // Everything below writes into scratch buffers; the engine's state changes only once the
@@ -200,39 +154,40 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   volume_rate_.resize(nc);
 #pragma omp parallel for schedule(static) reduction(max : max_change) if (nc > kMinParallelLoop)
   for (int c = 0; c < nc; ++c) {
-    const double v = cell_volume(cells_.shape[c], centres, walls);
+    const double v = cell_volume(mesh_->cells.shape[c], centres, walls);
     const double dv = has_prev_ ? v - volume_[c] : 0.0;
     volume_rate_[c] = dv / dt;
-    max_change = std::max(max_change, std::abs(dv) / std::max(v, mean_cell_volume_));
+    max_change = std::max(max_change, std::abs(dv) / std::max(v, mesh_->mean_cell_volume));
     next_volume_[c] = v;
   }
   step_times_.volumes = seconds_since(t0);
 
   t0 = Clock::now();
   next_pressure_ = pressure_;  // Gauss-Seidel warm start
-  apply_dirichlet_values(system_, bc, next_pressure_);
-  const int nu = system_.n_unknowns();
+  const PressureSystem& system = linear_.system;
+  apply_dirichlet_values(system, bc, next_pressure_);
+  const int nu = system.n_unknowns();
   rhs_.resize(nu);
-  for (int u = 0; u < nu; ++u) rhs_[u] = -volume_rate_[system_.unknown_cell[u]];
-  for (std::size_t i = 0; i < imposed_flux_cells_.size(); ++i) {
-    const int c = imposed_flux_cells_[i];
-    if (c >= 0 && system_.unknown[c] >= 0) rhs_[system_.unknown[c]] += bc.imposed_flux[i].value;
+  for (int u = 0; u < nu; ++u) rhs_[u] = -volume_rate_[system.unknown_cell[u]];
+  for (std::size_t i = 0; i < linear_.imposed_flux_cells.size(); ++i) {
+    const int c = linear_.imposed_flux_cells[i];
+    if (c >= 0 && system.unknown[c] >= 0) rhs_[system.unknown[c]] += bc.imposed_flux[i].value;
   }
   if (nu == 0) {
     // every cell has an imposed pressure: nothing to solve
   } else if (settings.use_solver == 0) {
-    const auto r = gauss_seidel(system_, rhs_, next_pressure_, settings.tolerance, settings.relax, settings.max_gs_iterations);
+    const auto r = gauss_seidel(system, rhs_, next_pressure_, settings.tolerance, settings.relax, settings.max_gs_iterations);
     gs_iterations_ = r.iterations;
   } else {
-    for (std::size_t i = 0; i < dirichlet_coupling_.size(); ++i)
-      rhs_[static_cast<int>(dirichlet_coupling_[i][0])] += dirichlet_coupling_[i][1] * next_pressure_[dirichlet_coupling_cell_[i]];
-    cholmod_->solve(rhs_, solution_);
-    for (int u = 0; u < nu; ++u) next_pressure_[system_.unknown_cell[u]] = solution_[u];
+    for (std::size_t i = 0; i < linear_.coupling_k.size(); ++i)
+      rhs_[linear_.coupling_unknown[i]] += linear_.coupling_k[i] * next_pressure_[linear_.coupling_cell[i]];
+    linear_.cholmod->solve(rhs_, solution_);
+    for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
   }
   step_times_.solve = seconds_since(t0);
 
   t0 = Clock::now();
-  cache_.apply(next_pressure_, next_force_);
+  mesh_->cache.apply(next_pressure_, next_force_);
   step_times_.forces = seconds_since(t0);
 
   // Never hand NaN or infinite forces back to the DEM.
@@ -254,33 +209,34 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
 }
 
 double FlowEngine::boundary_flux(int wall) const {
+  const PressureSystem& s = linear_.system;
   double q = 0;
-  for (std::size_t c = 0; c < system_.source.size(); ++c) {
-    if (system_.source[c] != wall) continue;
-    for (int e = system_.adj_start[c]; e < system_.adj_start[c + 1]; ++e)
-      q += system_.adj_k[e] * (pressure_[system_.adj_cell[e]] - pressure_[c]);
+  for (std::size_t c = 0; c < s.source.size(); ++c) {
+    if (s.source[c] != wall) continue;
+    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e) q += s.adj_k[e] * (pressure_[s.adj_cell[e]] - pressure_[c]);
   }
   return q;
 }
 
 double FlowEngine::imposed_flux_total() const {
   double q = 0;
-  for (std::size_t i = 0; i < imposed_flux_cells_.size(); ++i)
-    if (imposed_flux_cells_[i] >= 0 && system_.unknown[imposed_flux_cells_[i]] >= 0) q += bc.imposed_flux[i].value;
+  const auto& cells = linear_.imposed_flux_cells;
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    if (cells[i] >= 0 && linear_.system.unknown[cells[i]] >= 0) q += bc.imposed_flux[i].value;
   return q;
 }
 
 double FlowEngine::volume_rate_total() const {
   double s = 0;
-  for (int c : system_.unknown_cell) s += volume_rate_[c];
+  for (int c : linear_.system.unknown_cell) s += volume_rate_[c];
   return s;
 }
 
 double FlowEngine::average_pressure() const {
   double pv = 0, v = 0;
   for (std::size_t c = 0; c < pressure_.size(); ++c) {
-    pv += pressure_[c] * cells_.volume[c];
-    v += cells_.volume[c];
+    pv += pressure_[c] * mesh_->cells.volume[c];
+    v += mesh_->cells.volume[c];
   }
   return v > 0 ? pv / v : 0.0;
 }
@@ -298,7 +254,7 @@ double FlowEngine::average_slice_pressure(int axis, double position) const {
       x[axis] = position;
       x[a1] = walls_prev_.coord[2 * a1] + (i + 0.5) / kSamples * walls_prev_.extent(a1);
       x[a2] = walls_prev_.coord[2 * a2] + (j + 0.5) / kSamples * walls_prev_.extent(a2);
-      const int c = tri_.locate(x);
+      const int c = locate(x);
       if (c < 0) continue;
       sum += pressure_[c];
       ++count;

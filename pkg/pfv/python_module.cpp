@@ -65,7 +65,13 @@ py::dict times_dict(const StageTimes& t) {
   return d;
 }
 
+const FlowEngine& meshed(const FlowEngine& e) {
+  if (!e.has_mesh()) throw py::value_error("the engine has no pore mesh yet (run a step first)");
+  return e;
+}
+
 void check_cell(const FlowEngine& e, int id) {
+  meshed(e);
   if (id < 0 || id >= e.mesh().n_cells()) throw py::index_error("no pore cell with index " + std::to_string(id));
 }
 
@@ -162,6 +168,10 @@ PYBIND11_MODULE(_core, m) {
                     })
       .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholmod().factor_nonzeros(); })
       .def("factor_flops", [](const FlowEngine& e) { return e.cholmod().factor_flops(); })
+      .def_property("background_remesh", [](const FlowEngine& e) { return e.settings.background_remesh; },
+                    [](FlowEngine& e, bool v) { e.settings.background_remesh = v; })
+      .def("remesh_pending", &FlowEngine::remesh_pending)
+      .def("wait_for_remesh", &FlowEngine::wait_for_remesh, py::call_guard<py::gil_scoped_release>())
       .def_property("mesh_update_interval", [](const FlowEngine& e) { return e.settings.mesh_update_interval; },
                     [](FlowEngine& e, int v) { e.settings.mesh_update_interval = v; })
       .def_property("def_tolerance", [](const FlowEngine& e) { return e.settings.def_tolerance; },
@@ -220,11 +230,11 @@ PYBIND11_MODULE(_core, m) {
       .def("cell_pressure", [](const FlowEngine& e, int id) { check_cell(e, id); return e.pressure()[id]; })
       .def("cell_center", [](const FlowEngine& e, int id) {
              check_cell(e, id);
-             const Vec3& c = e.cells().power_centre[id];
+             const Vec3& c = meshed(e).cells().power_centre[id];
              return std::array<double, 3>{c.x(), c.y(), c.z()};
            })
-      .def("cell_volume", [](const FlowEngine& e, int id) { check_cell(e, id); return e.cells().volume[id]; })
-      .def("cell_fluid_volume", [](const FlowEngine& e, int id) { check_cell(e, id); return e.cells().fluid_volume[id]; })
+      .def("cell_volume", [](const FlowEngine& e, int id) { check_cell(e, id); return meshed(e).cells().volume[id]; })
+      .def("cell_fluid_volume", [](const FlowEngine& e, int id) { check_cell(e, id); return meshed(e).cells().fluid_volume[id]; })
       .def("metis_used", &FlowEngine::metis_used)
       .def("hidden_spheres", [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; })
       .def_property_readonly("remesh_count", &FlowEngine::remesh_count)
@@ -235,14 +245,14 @@ PYBIND11_MODULE(_core, m) {
       .def("step_times", [](const FlowEngine& e) { return times_dict(e.step_times()); })
       // Geometry, for tests and post-processing.
       .def("cell_vertices", [](const FlowEngine& e) {
-             const auto& cv = e.mesh().cell_vertices;
+             const auto& cv = meshed(e).mesh().cell_vertices;
              py::array_t<int> out({static_cast<py::ssize_t>(cv.size()), py::ssize_t{4}});
              if (!cv.empty()) std::memcpy(out.mutable_data(), cv.data(), cv.size() * sizeof(cv[0]));
              return out;
            })
-      .def("cell_volumes", [](const FlowEngine& e) { return vector_to_array(e.cells().volume); })
-      .def("cell_fluid_volumes", [](const FlowEngine& e) { return vector_to_array(e.cells().fluid_volume); })
-      .def("cell_centers", [](const FlowEngine& e) { return points_to_array(e.cells().power_centre); })
-      .def("conductances", [](const FlowEngine& e) { return vector_to_array(e.conductances()); })
-      .def("facet_cells", [](const FlowEngine& e) { return e.facets().cell; });
+      .def("cell_volumes", [](const FlowEngine& e) { return vector_to_array(meshed(e).cells().volume); })
+      .def("cell_fluid_volumes", [](const FlowEngine& e) { return vector_to_array(meshed(e).cells().fluid_volume); })
+      .def("cell_centers", [](const FlowEngine& e) { return points_to_array(meshed(e).cells().power_centre); })
+      .def("conductances", [](const FlowEngine& e) { return vector_to_array(meshed(e).conductances()); })
+      .def("facet_cells", [](const FlowEngine& e) { return meshed(e).facets().cell; });
 }

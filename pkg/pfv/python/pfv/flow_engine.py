@@ -79,6 +79,7 @@ _SUPPORTED = {
     "meshUpdateInterval": "mesh_update_interval",
     "defTolerance": "def_tolerance",
     "pZero": "p_zero",
+    "multithread": "background_remesh",
 }
 
 

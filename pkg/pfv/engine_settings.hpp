@@ -1,0 +1,31 @@
+// User settings of the flow engine, and the per-stage timings it reports.
+#pragma once
+#include "cholmod_solver.hpp"
+#include "conductance.hpp"
+
+namespace pfv {
+
+struct EngineSettings {
+  ConductanceModel conductance;
+  bool slip_boundary = true;
+  int use_solver = 3;  // 0 Gauss-Seidel, 3 CHOLMOD
+  double tolerance = 1e-6;
+  double relax = 1.9;
+  int max_gs_iterations = 200000;
+  bool force_metis = false;  // YADE's forceMetis: METIS ordering whatever 'ordering' says
+  Ordering ordering = Ordering::kAuto;
+  int mesh_update_interval = 1000;
+  double def_tolerance = 0;  // YADE's default: no strain-triggered remesh
+  double p_zero = 0;
+  // Remesh on a second thread from a snapshot while steps go on with the old mesh (YADE's
+  // `multithread`): the new mesh arrives a few steps late.
+  bool background_remesh = false;
+};
+
+// Seconds spent in each stage: the last remesh, and the last step without remesh.
+struct StageTimes {
+  double triangulation = 0, geometry = 0, conductance = 0, assembly = 0, analysis = 0, factorization = 0;
+  double force_cache = 0, volumes = 0, solve = 0, forces = 0;
+};
+
+}  // namespace pfv

@@ -1,0 +1,93 @@
+#include "pore_mesh.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+namespace pfv {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string describe(const Vec3& x) {
+  std::ostringstream s;
+  s << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
+  return s.str();
+}
+
+}  // namespace
+
+PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                         const BoxWalls& walls, const EngineSettings& settings) {
+  // Coincident centres make the triangulation drop a sphere silently: refuse them.
+  std::vector<int> order(centres.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return std::lexicographical_compare(centres[a].data(), centres[a].data() + 3, centres[b].data(), centres[b].data() + 3);
+  });
+  for (std::size_t i = 1; i < order.size(); ++i)
+    if (centres[order[i]] == centres[order[i - 1]])
+      throw std::invalid_argument("sphere " + std::to_string(order[i - 1]) + " and sphere " +
+                                  std::to_string(order[i]) + " have coincident centres " + describe(centres[order[i]]));
+
+  PoreMesh m;
+  auto t0 = Clock::now();
+  const Mesh& mesh = m.tri.build(centres, radii, walls);
+  const auto inside = m.tri.centres_inside_neighbours(centres, radii);
+  if (!inside.empty())
+    throw std::invalid_argument("sphere " + std::to_string(inside[0].first) + " and sphere " +
+                                std::to_string(inside[0].second) +
+                                " overlap so much that one centre lies inside the other sphere (" +
+                                std::to_string(inside.size()) + " such pairs); the pore mesh would be degenerate");
+  if (mesh.n_cells() == 0) throw std::invalid_argument("the triangulation has no pore cell");
+  m.times.triangulation = seconds_since(t0);
+
+  t0 = Clock::now();
+  const Packing packing{centres, radii, walls};
+  m.cells = compute_cell_geometry(mesh, packing);
+  m.facets = compute_facet_geometry(mesh, m.cells, packing, settings.slip_boundary);
+  m.mean_cell_volume = std::accumulate(m.cells.volume.begin(), m.cells.volume.end(), 0.0) / mesh.n_cells();
+  m.times.geometry = seconds_since(t0);
+
+  t0 = Clock::now();
+  m.k = throat_conductances(m.facets, settings.conductance);
+  m.times.conductance = seconds_since(t0);
+
+  t0 = Clock::now();
+  m.cache.build(mesh, m.facets, packing);
+  m.times.force_cache = seconds_since(t0);
+  return m;
+}
+
+LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc,
+                                 const EngineSettings& settings) {
+  LinearSystem l;
+  for (const auto& c : bc.imposed_pressure) l.imposed_pressure_cells.push_back(m.tri.locate(c.position));
+  for (const auto& c : bc.imposed_flux) l.imposed_flux_cells.push_back(m.tri.locate(c.position));
+
+  auto t0 = Clock::now();
+  l.system = assemble_pressure_system(m.mesh(), m.facets, m.k, bc, l.imposed_pressure_cells);
+  const PressureSystem& s = l.system;
+  for (int u = 0; u < s.n_unknowns(); ++u) {
+    const int c = s.unknown_cell[u];
+    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e)
+      if (s.unknown[s.adj_cell[e]] < 0) {
+        l.coupling_unknown.push_back(u);
+        l.coupling_cell.push_back(s.adj_cell[e]);
+        l.coupling_k.push_back(s.adj_k[e]);
+      }
+  }
+  l.times.assembly = seconds_since(t0);
+
+  t0 = Clock::now();
+  if (settings.use_solver != 0 && s.n_unknowns() > 0)
+    l.cholmod->factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering);
+  l.times.analysis = l.cholmod->analysis_seconds();
+  l.times.factorization = seconds_since(t0) - l.times.analysis;
+  return l;
+}
+
+}  // namespace pfv

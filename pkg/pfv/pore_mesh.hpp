@@ -1,0 +1,47 @@
+// The products of a remesh, built from one snapshot and independent of the engine's state:
+// the pore mesh (triangulation, geometry, conductances, force cache) and the linear system
+// over it (assembly and factorisation for given boundary conditions). Building them touches
+// nothing shared, so a remesh can run on another thread.
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "boundary_conditions.hpp"
+#include "engine_settings.hpp"
+#include "force_cache.hpp"
+#include "pore_geometry.hpp"
+#include "pressure_system.hpp"
+#include "regular_triangulation.hpp"
+
+namespace pfv {
+
+struct PoreMesh {
+  RegularTriangulation tri;
+  CellGeometry cells;
+  FacetGeometry facets;
+  std::vector<double> k;
+  ForceCache cache;
+  double mean_cell_volume = 0;
+  StageTimes times;  // triangulation, geometry, conductance, force_cache
+
+  const Mesh& mesh() const { return tri.mesh(); }
+};
+
+struct LinearSystem {
+  PressureSystem system;
+  std::vector<int> coupling_unknown, coupling_cell;  // Dirichlet neighbours of unknowns
+  std::vector<double> coupling_k;
+  std::unique_ptr<CholmodSolver> cholmod = std::make_unique<CholmodSolver>();
+  std::vector<int> imposed_pressure_cells, imposed_flux_cells;
+  StageTimes times;  // assembly, analysis, factorization
+};
+
+// Throws std::invalid_argument for coincident centres or a centre inside another sphere.
+PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                         const BoxWalls& walls, const EngineSettings& settings);
+
+// Throws std::domain_error if the system is singular.
+LinearSystem build_linear_system(const PoreMesh& mesh, const BoundaryConditions& bc,
+                                 const EngineSettings& settings);
+
+}  // namespace pfv

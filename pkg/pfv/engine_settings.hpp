@@ -8,7 +8,7 @@ namespace pfv {
 struct EngineSettings {
   ConductanceModel conductance;
   bool slip_boundary = true;
-  int use_solver = 3;  // 0 Gauss-Seidel, 3 CHOLMOD
+  int use_solver = 3;  // 0 Gauss-Seidel, 1 preconditioned CG (PFV), 3 CHOLMOD
   double tolerance = 1e-6;
   double relax = 1.9;
   int max_gs_iterations = 200000;

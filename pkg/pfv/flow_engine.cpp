@@ -93,8 +93,8 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     bad_input("viscosity must be positive and finite");
   if (!(settings.conductance.permeability_factor > 0))
     bad_input("permeabilityFactor must be positive (the negative 'homogeneous' variant is not supported)");
-  if (settings.use_solver != 0 && settings.use_solver != 3)
-    bad_input("useSolver must be 0 (Gauss-Seidel) or 3 (CHOLMOD)");
+  if (settings.use_solver != 0 && settings.use_solver != 1 && settings.use_solver != 3)
+    bad_input("useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG) or 3 (CHOLMOD)");
   validate_snapshot(centres, radii, walls);
 
   const bool same_spheres = has_mesh() && centres.size() == static_cast<std::size_t>(mesh().n_spheres);
@@ -136,9 +136,11 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
       remesh_requested_ = false;
     }
   }
-  if (linear_bc_version_ != bc_version_ ||
-      (settings.use_solver != 0 && linear_.system.n_unknowns() > 0 && !linear_.cholmod->ready())) {
-    // New boundary conditions, or switched from Gauss-Seidel to CHOLMOD.
+  const bool solver_missing = linear_.system.n_unknowns() > 0 &&
+                              ((settings.use_solver == 3 && !linear_.cholmod->ready()) ||
+                               (settings.use_solver == 1 && !linear_.pcg.ready()));
+  if (linear_bc_version_ != bc_version_ || solver_missing) {
+    // New boundary conditions, or a solver chosen after the last remesh.
     linear_ = build_linear_system(*mesh_, bc, settings);
     linear_bc_version_ = bc_version_;
   }
@@ -178,6 +180,14 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   } else if (settings.use_solver == 0) {
     const auto r = gauss_seidel(system, rhs_, next_pressure_, settings.tolerance, settings.relax, settings.max_gs_iterations);
     gs_iterations_ = r.iterations;
+  } else if (settings.use_solver == 1) {
+    for (std::size_t i = 0; i < linear_.coupling_k.size(); ++i)
+      rhs_[linear_.coupling_unknown[i]] += linear_.coupling_k[i] * next_pressure_[linear_.coupling_cell[i]];
+    solution_.resize(nu);
+    for (int u = 0; u < nu; ++u) solution_[u] = next_pressure_[system.unknown_cell[u]];  // warm start
+    linear_.pcg.solve(rhs_, solution_, settings.tolerance, settings.max_gs_iterations);
+    gs_iterations_ = linear_.pcg.iterations();
+    for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
   } else {
     for (std::size_t i = 0; i < linear_.coupling_k.size(); ++i)
       rhs_[linear_.coupling_unknown[i]] += linear_.coupling_k[i] * next_pressure_[linear_.coupling_cell[i]];

@@ -83,8 +83,9 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   l.times.assembly = seconds_since(t0);
 
   t0 = Clock::now();
-  if (settings.use_solver != 0 && s.n_unknowns() > 0)
+  if (settings.use_solver == 3 && s.n_unknowns() > 0)
     l.cholmod->factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering);
+  if (settings.use_solver == 1 && s.n_unknowns() > 0) l.pcg.setup(s);
   l.times.analysis = l.cholmod->analysis_seconds();
   l.times.factorization = seconds_since(t0) - l.times.analysis;
   return l;

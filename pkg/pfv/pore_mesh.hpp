@@ -9,6 +9,7 @@
 #include "boundary_conditions.hpp"
 #include "engine_settings.hpp"
 #include "force_cache.hpp"
+#include "pcg_solver.hpp"
 #include "pore_geometry.hpp"
 #include "pressure_system.hpp"
 #include "regular_triangulation.hpp"
@@ -31,7 +32,8 @@ struct LinearSystem {
   PressureSystem system;
   std::vector<int> coupling_unknown, coupling_cell;  // Dirichlet neighbours of unknowns
   std::vector<double> coupling_k;
-  std::unique_ptr<CholmodSolver> cholmod = std::make_unique<CholmodSolver>();
+  std::unique_ptr<CholmodSolver> cholmod = std::make_unique<CholmodSolver>();  // useSolver 3
+  PcgSolver pcg;                                                               // useSolver 1
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;
   StageTimes times;  // assembly, analysis, factorization
 };

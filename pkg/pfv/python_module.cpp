@@ -139,7 +139,8 @@ PYBIND11_MODULE(_core, m) {
                     [](FlowEngine& e, bool v) { e.settings.slip_boundary = v; e.request_remesh(); })
       .def_property("use_solver", [](const FlowEngine& e) { return e.settings.use_solver; },
                     [](FlowEngine& e, int v) {
-                      if (v != 0 && v != 3) throw py::value_error("useSolver must be 0 (Gauss-Seidel) or 3 (CHOLMOD)");
+                      if (v != 0 && v != 1 && v != 3)
+                        throw py::value_error("useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG, PFV) or 3 (CHOLMOD)");
                       e.settings.use_solver = v;
                     })
       .def_property("tolerance", [](const FlowEngine& e) { return e.settings.tolerance; },

@@ -252,3 +252,21 @@ TEST(FlowEngine, FailedBackgroundRemeshSurfacesAndRecovers) {
   const double out = e.boundary_flux(0) + e.boundary_flux(1);
   EXPECT_NEAR(out, -e.volume_rate_total(), 1e-8 * std::abs(e.boundary_flux(0)));
 }
+
+TEST(FlowModel, PreconditionedCgMatchesDirectAndWarmStartPays) {
+  auto p = test::random_packing(300, 33);
+  FlowEngine direct = permeameter(1), cg = permeameter(1);
+  cg.settings.use_solver = 1;
+  cg.settings.tolerance = 1e-12;
+  direct.step(p.centre, p.radius, p.walls, 1e-3);
+  cg.step(p.centre, p.radius, p.walls, 1e-3);
+  for (std::size_t c = 0; c < direct.pressure().size(); ++c) EXPECT_NEAR(cg.pressure()[c], direct.pressure()[c], 1e-9);
+  const int cold = cg.gs_iterations();
+  // A small deformation: the warm start from the previous pressures needs fewer iterations.
+  for (auto& x : p.centre) x = Vec3(0.5, 0.5, 0.5) + 0.99999 * (x - Vec3(0.5, 0.5, 0.5));
+  direct.step(p.centre, p.radius, p.walls, 1e-3);
+  cg.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_LT(cg.gs_iterations(), cold);
+  for (std::size_t c = 0; c < direct.pressure().size(); ++c)
+    EXPECT_NEAR(cg.pressure()[c], direct.pressure()[c], 1e-9 * (1 + std::abs(direct.pressure()[c])));
+}

@@ -17,6 +17,10 @@ struct EngineSettings {
   int mesh_update_interval = 1000;
   double def_tolerance = 0;  // YADE's default: no strain-triggered remesh
   double p_zero = 0;
+  // Fluid bulk modulus K (YADE's fluidBulkModulus); 0 = incompressible. When positive each
+  // cell stores fluid: (V_f / K) dp/dt enters continuity (implicit Euler), which adds
+  // V_f / (K dt) to the diagonal of G; the system is then refactorised when dt changes.
+  double fluid_bulk_modulus = 0;
   // Remesh on a second thread from a snapshot while steps go on with the old mesh (YADE's
   // `multithread`): the new mesh arrives a few steps late.
   bool background_remesh = false;

@@ -59,9 +59,10 @@ bool FlowEngine::remesh_due() const {
 }
 
 void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, int bc_version) {
-  // Warm start for Gauss-Seidel: the old pressure at the new pore centres.
+  // The old pressure at the new pore centres: the state of a compressible fluid, and the warm
+  // start of the iterative solvers. (The direct solve of an incompressible fluid needs neither.)
   std::vector<double> pressure(mesh.mesh().n_cells(), settings.p_zero);
-  if (settings.use_solver == 0 && has_mesh())
+  if ((settings.use_solver != 3 || settings.fluid_bulk_modulus > 0) && has_mesh())
     for (int c = 0; c < mesh.mesh().n_cells(); ++c) {
       const int old = mesh_->tri.locate(mesh.cells.power_centre[c]);
       if (old >= 0) pressure[c] = pressure_[old];
@@ -119,9 +120,9 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     if (settings.background_remesh && same_spheres && !remesh_requested_) {
       // Snapshot now, build on another thread, carry on with the current mesh meanwhile.
       pending_ = Pending{std::async(std::launch::async,
-                                    [c = centres, r = radii, w = walls, s = settings, b = bc]() {
+                                    [c = centres, r = radii, w = walls, s = settings, b = bc, dt]() {
                                       PoreMesh m = build_pore_mesh(c, r, w, s);
-                                      LinearSystem l = build_linear_system(m, b, s);
+                                      LinearSystem l = build_linear_system(m, b, s, dt);
                                       return Remesh(std::move(m), std::move(l));
                                     }),
                          bc_version_};
@@ -129,7 +130,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
       steps_since_remesh_ = 0;
     } else {
       PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
-      LinearSystem l = build_linear_system(m, bc, settings);
+      LinearSystem l = build_linear_system(m, bc, settings, dt);
       adopt(std::move(m), std::move(l), bc_version_);
       strain_ = 0;
       steps_since_remesh_ = 0;
@@ -139,9 +140,12 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   const bool solver_missing = linear_.system.n_unknowns() > 0 &&
                               ((settings.use_solver == 3 && !linear_.cholmod->ready()) ||
                                (settings.use_solver == 1 && !linear_.pcg.ready()));
-  if (linear_bc_version_ != bc_version_ || solver_missing) {
-    // New boundary conditions, or a solver chosen after the last remesh.
-    linear_ = build_linear_system(*mesh_, bc, settings);
+  const bool storage_stale = (settings.fluid_bulk_modulus > 0) != !linear_.storage.empty() ||
+                             (!linear_.storage.empty() && dt != linear_.dt);
+  if (linear_bc_version_ != bc_version_ || solver_missing || storage_stale) {
+    // New boundary conditions, a solver chosen after the last remesh, or a new dt or bulk
+    // modulus with a compressible fluid.
+    linear_ = build_linear_system(*mesh_, bc, settings, dt);
     linear_bc_version_ = bc_version_;
   }
 
@@ -171,6 +175,8 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   const int nu = system.n_unknowns();
   rhs_.resize(nu);
   for (int u = 0; u < nu; ++u) rhs_[u] = -volume_rate_[system.unknown_cell[u]];
+  if (!linear_.storage.empty())  // implicit Euler on the stored fluid: + V_f/(K dt) p^n
+    for (int u = 0; u < nu; ++u) rhs_[u] += linear_.storage[system.unknown_cell[u]] * pressure_[system.unknown_cell[u]];
   for (std::size_t i = 0; i < linear_.imposed_flux_cells.size(); ++i) {
     const int c = linear_.imposed_flux_cells[i];
     if (c >= 0 && system.unknown[c] >= 0) rhs_[system.unknown[c]] += bc.imposed_flux[i].value;

@@ -63,13 +63,19 @@ PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<dou
 }
 
 LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc,
-                                 const EngineSettings& settings) {
+                                 const EngineSettings& settings, double dt) {
   LinearSystem l;
+  l.dt = dt;
+  if (settings.fluid_bulk_modulus > 0) {
+    l.storage.resize(m.mesh().n_cells());
+    for (int c = 0; c < m.mesh().n_cells(); ++c)
+      l.storage[c] = m.cells.fluid_volume[c] / (settings.fluid_bulk_modulus * dt);
+  }
   for (const auto& c : bc.imposed_pressure) l.imposed_pressure_cells.push_back(m.tri.locate(c.position));
   for (const auto& c : bc.imposed_flux) l.imposed_flux_cells.push_back(m.tri.locate(c.position));
 
   auto t0 = Clock::now();
-  l.system = assemble_pressure_system(m.mesh(), m.facets, m.k, bc, l.imposed_pressure_cells);
+  l.system = assemble_pressure_system(m.mesh(), m.facets, m.k, bc, l.imposed_pressure_cells, l.storage);
   const PressureSystem& s = l.system;
   for (int u = 0; u < s.n_unknowns(); ++u) {
     const int c = s.unknown_cell[u];

@@ -35,6 +35,8 @@ struct LinearSystem {
   std::unique_ptr<CholmodSolver> cholmod = std::make_unique<CholmodSolver>();  // useSolver 3
   PcgSolver pcg;                                                               // useSolver 1
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;
+  std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid
+  double dt = 0;                // the time step 'storage' was built for
   StageTimes times;  // assembly, analysis, factorization
 };
 
@@ -44,6 +46,6 @@ PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<dou
 
 // Throws std::domain_error if the system is singular.
 LinearSystem build_linear_system(const PoreMesh& mesh, const BoundaryConditions& bc,
-                                 const EngineSettings& settings);
+                                 const EngineSettings& settings, double dt);
 
 }  // namespace pfv

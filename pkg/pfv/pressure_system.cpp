@@ -10,7 +10,8 @@ namespace pfv {
 PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets,
                                         const std::vector<double>& k,
                                         const BoundaryConditions& bc,
-                                        const std::vector<int>& imposed_cells) {
+                                        const std::vector<int>& imposed_cells,
+                                        const std::vector<double>& storage) {
   const int nc = mesh.n_cells();
   PressureSystem s;
   s.source.assign(nc, -1);
@@ -50,11 +51,15 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
     s.diagonal[b] += k[f];
   }
 
-  // Every connected group of unknowns must reach a Dirichlet cell, else G is singular.
+  if (!storage.empty())
+    for (int c = 0; c < nc; ++c) s.diagonal[c] += storage[c];
+
+  // Every connected group of unknowns must reach a Dirichlet cell (or a compressible cell),
+  // else G is singular.
   std::vector<char> reached(nc, 0);
   std::vector<int> stack;
   for (int c = 0; c < nc; ++c)
-    if (s.unknown[c] < 0) {
+    if (s.unknown[c] < 0 || (!storage.empty() && storage[c] > 0)) {
       reached[c] = 1;
       stack.push_back(c);
     }

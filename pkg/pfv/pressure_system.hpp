@@ -31,10 +31,12 @@ struct PressureSystem {
 };
 
 // imposed_cells[k] is the cell of bc.imposed_pressure[k] (-1 if it lies in no cell).
+// storage (optional, per cell) adds V_i / (K dt) to the diagonal: fluid compressibility.
 PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets,
                                         const std::vector<double>& k,
                                         const BoundaryConditions& bc,
-                                        const std::vector<int>& imposed_cells);
+                                        const std::vector<int>& imposed_cells,
+                                        const std::vector<double>& storage = {});
 
 // Pressures of the Dirichlet cells from the current boundary values (cheap; every step).
 void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc,

@@ -169,6 +169,11 @@ PYBIND11_MODULE(_core, m) {
                     })
       .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholmod().factor_nonzeros(); })
       .def("factor_flops", [](const FlowEngine& e) { return e.cholmod().factor_flops(); })
+      .def_property("fluid_bulk_modulus", [](const FlowEngine& e) { return e.settings.fluid_bulk_modulus; },
+                    [](FlowEngine& e, double v) {
+                      if (!(v >= 0 && std::isfinite(v))) throw py::value_error("fluidBulkModulus must be >= 0 and finite");
+                      e.settings.fluid_bulk_modulus = v;
+                    })
       .def_property("background_remesh", [](const FlowEngine& e) { return e.settings.background_remesh; },
                     [](FlowEngine& e, bool v) { e.settings.background_remesh = v; })
       .def("remesh_pending", &FlowEngine::remesh_pending)

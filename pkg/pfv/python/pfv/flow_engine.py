@@ -80,6 +80,7 @@ _SUPPORTED = {
     "defTolerance": "def_tolerance",
     "pZero": "p_zero",
     "multithread": "background_remesh",
+    "fluidBulkModulus": "fluid_bulk_modulus",
 }
 
 

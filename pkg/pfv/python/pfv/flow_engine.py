@@ -267,9 +267,11 @@ class FlowEngine(PyRunner):
     def _step(self):
         O = yade.O
         core = self._core
-        if self._ids is None or core.remesh_due() or len(O.bodies) != self._n_bodies:
-            self._scan_bodies()
-            core.request_remesh()
+        bodies_changed = self._ids is None or len(O.bodies) != self._n_bodies
+        if bodies_changed or core.remesh_due():
+            self._scan_bodies()  # radii and masses may have changed too
+            if bodies_changed:
+                core.request_remesh()
         set_num_threads(self._threads or O.numThreads)
         self._check_time_step(O.dt)
         xyz = self._positions()

@@ -4,49 +4,20 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
-#include <sstream>
 #include <stdexcept>
 
 #include "gauss_seidel_solver.hpp"
 #include "pore_mesh.hpp"
+#include "snapshot.hpp"
 
 namespace pfv {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 [[noreturn]] void bad_input(const std::string& what) { throw std::invalid_argument(what); }
 
-std::string describe(const Vec3& x) {
-  std::ostringstream s;
-  s << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
-  return s.str();
-}
-
 }  // namespace
-
-void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                       const BoxWalls& walls) {
-  if (centres.size() != radii.size()) bad_input("positions and radii differ in length");
-  if (centres.empty()) bad_input("no spheres to couple with the fluid");
-  for (int w = 0; w < kWallCount; ++w)
-    if (!std::isfinite(walls.coord[w])) bad_input("wall " + std::to_string(w) + " position is not finite");
-  for (int a = 0; a < 3; ++a)
-    if (!(walls.extent(a) > 0))
-      bad_input("walls " + std::to_string(2 * a) + " and " + std::to_string(2 * a + 1) +
-                " are not in increasing order (min wall at or beyond max wall)");
-  for (std::size_t k = 0; k < centres.size(); ++k) {
-    if (!centres[k].allFinite()) bad_input("sphere " + std::to_string(k) + " has a non-finite position " + describe(centres[k]));
-    if (!(std::isfinite(radii[k]) && radii[k] > 0)) bad_input("sphere " + std::to_string(k) + " has a non-positive or non-finite radius");
-    for (int w = 0; w < kWallCount; ++w)
-      if (!(walls.height(w, centres[k]) > 0))
-        bad_input("sphere " + std::to_string(k) + " centre " + describe(centres[k]) + " is outside wall " +
-                  std::to_string(w) + " (at " + std::to_string(walls.coord[w]) + ")");
-  }
-}
 
 FlowEngine::~FlowEngine() {
   if (pending_) pending_->result.wait();  // the worker reads copies only, but let it finish

@@ -13,6 +13,7 @@
 #include "boundary_conditions.hpp"
 #include "engine_settings.hpp"
 #include "pore_mesh.hpp"
+#include "snapshot.hpp"
 
 namespace pfv {
 
@@ -98,9 +99,5 @@ class FlowEngine {
   bool remesh_requested_ = true;
   StageTimes remesh_times_, step_times_;
 };
-
-// Checks a scene snapshot; throws std::invalid_argument naming the first problem.
-void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                       const BoxWalls& walls);
 
 }  // namespace pfv

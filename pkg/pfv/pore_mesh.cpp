@@ -1,37 +1,20 @@
 #include "pore_mesh.hpp"
 
+#include "snapshot.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <numeric>
-#include <sstream>
 #include <stdexcept>
 
 namespace pfv {
 namespace {
-
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-std::string describe(const Vec3& x) {
-  std::ostringstream s;
-  s << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
-  return s.str();
-}
-
 }  // namespace
 
 PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
                          const BoxWalls& walls, const EngineSettings& settings) {
-  // Coincident centres make the triangulation drop a sphere silently: refuse them.
-  std::vector<int> order(centres.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return std::lexicographical_compare(centres[a].data(), centres[a].data() + 3, centres[b].data(), centres[b].data() + 3);
-  });
-  for (std::size_t i = 1; i < order.size(); ++i)
-    if (centres[order[i]] == centres[order[i - 1]])
-      throw std::invalid_argument("sphere " + std::to_string(order[i - 1]) + " and sphere " +
-                                  std::to_string(order[i]) + " have coincident centres " + describe(centres[order[i]]));
+  check_distinct_centres(centres);
 
   PoreMesh m;
   auto t0 = Clock::now();

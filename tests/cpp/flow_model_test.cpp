@@ -11,17 +11,7 @@
 #include "test_packings.hpp"
 
 using namespace pfv;
-
-namespace {
-
-FlowEngine permeameter(int axis = 0, double p_in = 1.0) {
-  FlowEngine e;
-  e.bc.is_pressure[2 * axis] = e.bc.is_pressure[2 * axis + 1] = true;
-  e.bc.value[2 * axis] = p_in;
-  return e;
-}
-
-}  // namespace
+using test::permeameter;
 
 TEST(Conductance, PoiseuilleForACircularTube) {
   // A throat with R_h = r/2 and A = pi r^2 must carry pi r^4 / (8 mu L).

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "box_walls.hpp"
+#include "flow_engine.hpp"
 #include "vec3.hpp"
 
 namespace pfv::test {
@@ -32,6 +33,14 @@ inline TestPacking random_packing(int n, unsigned seed, double rmin = 0.03, doub
     }
   }
   return p;
+}
+
+// An engine set up as a permeameter along 'axis': pressure p_in on the min wall, 0 on the max.
+inline FlowEngine permeameter(int axis = 0, double p_in = 1.0) {
+  FlowEngine e;
+  e.bc.is_pressure[2 * axis] = e.bc.is_pressure[2 * axis + 1] = true;
+  e.bc.value[2 * axis] = p_in;
+  return e;
 }
 
 }  // namespace pfv::test

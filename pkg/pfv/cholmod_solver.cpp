@@ -1,6 +1,9 @@
 #include "cholmod_solver.hpp"
 
 #include <suitesparse/cholmod.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <chrono>
 #include <cstring>
@@ -40,6 +43,7 @@ void CholmodSolver::release() {
       *d = nullptr;
     }
   factor_ = nullptr;
+  parallel_ = ParallelSubstitution{};  // it points into the factor just freed
 }
 
 double CholmodSolver::factor_nonzeros() const {
@@ -96,9 +100,32 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering) {
     throw std::runtime_error("CHOLMOD factorisation failed (status " + std::to_string(c->status) + ")");
   }
   rhs_ = cholmod_zeros(n, 1, CHOLMOD_REAL, c);
+  if (f->is_super && f->is_ll) {
+    SupernodalFactor view;
+    view.n = n;
+    view.nsuper = static_cast<int>(f->nsuper);
+    view.super = static_cast<const int*>(f->super);
+    view.pi = static_cast<const int*>(f->pi);
+    view.px = static_cast<const int*>(f->px);
+    view.rows = static_cast<const int*>(f->s);
+    view.perm = static_cast<const int*>(f->Perm);
+    view.values = static_cast<const double*>(f->x);
+    parallel_.plan(view, 2);
+  }
 }
 
 void CholmodSolver::solve(const std::vector<double>& rhs, std::vector<double>& x) {
+#ifdef _OPENMP
+  if (factor_ && parallel_.threads() > 1 && omp_get_max_threads() > 1) {
+    x.resize(rhs.size());
+    parallel_.solve(rhs.data(), x.data());
+    return;
+  }
+#endif
+  solve_serial(rhs, x);
+}
+
+void CholmodSolver::solve_serial(const std::vector<double>& rhs, std::vector<double>& x) {
   if (!factor_) {
     x.clear();
     return;

@@ -4,6 +4,8 @@
 #pragma once
 #include <vector>
 
+#include "parallel_substitution.hpp"
+
 namespace pfv {
 
 struct PressureSystem;
@@ -20,7 +22,11 @@ class CholmodSolver {
 
   // Throws std::domain_error if G is not positive definite.
   void factorize(const PressureSystem& system, Ordering ordering);
+  // With two or more OpenMP threads the substitutions run on subtrees in parallel
+  // (parallel_substitution.hpp); with one, CHOLMOD's own (BLAS-based) solve is used.
   void solve(const std::vector<double>& rhs, std::vector<double>& x);
+  void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
+  double parallel_top_fraction() const { return parallel_.top_fraction(); }
   bool metis_used() const { return metis_used_; }
   bool ready() const { return factor_ != nullptr; }
   double factor_nonzeros() const;
@@ -36,6 +42,7 @@ class CholmodSolver {
   void* x_ = nullptr;
   void* work_y_ = nullptr;
   void* work_e_ = nullptr;
+  ParallelSubstitution parallel_;
   bool metis_used_ = false;
   double analysis_seconds_ = 0;
 };

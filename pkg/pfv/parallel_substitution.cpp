@@ -1,0 +1,198 @@
+#include "parallel_substitution.hpp"
+
+#include <algorithm>
+#include <numeric>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace pfv {
+namespace {
+
+// Dot product with four partial sums (vectorises without -ffast-math).
+inline double dot(const double* a, const double* b, int n) {
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  int i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += a[i] * b[i];
+    s1 += a[i + 1] * b[i + 1];
+    s2 += a[i + 2] * b[i + 2];
+    s3 += a[i + 3] * b[i + 3];
+  }
+  for (; i < n; ++i) s0 += a[i] * b[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
+}  // namespace
+
+void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
+  L_ = f;
+  const int ns = f.nsuper;
+  std::vector<int> super_of(f.n);
+  for (int s = 0; s < ns; ++s)
+    for (int k = f.super[s]; k < f.super[s + 1]; ++k) super_of[k] = s;
+  std::vector<int> parent(ns, -1), first(ns);
+  std::vector<double> work(ns), subtree(ns);
+  std::vector<std::vector<int>> children(ns);
+  std::vector<int> roots;
+  std::size_t max_rows = 0;
+  for (int s = 0; s < ns; ++s) {
+    const int nscol = f.super[s + 1] - f.super[s], nsrow = f.pi[s + 1] - f.pi[s];
+    max_rows = std::max<std::size_t>(max_rows, nsrow);
+    work[s] = nscol * (nsrow - 0.5 * nscol);
+    if (nsrow > nscol) {
+      parent[s] = super_of[f.rows[f.pi[s] + nscol]];
+      children[parent[s]].push_back(s);
+    } else {
+      roots.push_back(s);
+    }
+  }
+  // Supernodes are postordered (children first), so subtrees are contiguous ranges.
+  for (int s = 0; s < ns; ++s) {
+    first[s] = s;
+    subtree[s] = work[s];
+  }
+  for (int s = 0; s < ns; ++s)
+    for (int c : children[s]) {
+      first[s] = std::min(first[s], first[c]);
+      subtree[s] += subtree[c];
+    }
+  const double total = std::accumulate(work.begin(), work.end(), 0.0);
+
+  // Split the heaviest open subtree until the groups balance (longest-processing-time).
+  std::vector<int> open = roots;
+  std::vector<char> is_top(ns, 0);
+  double top_work = 0;
+  std::vector<std::vector<int>> best_groups;
+  double best_time = total;  // time of the serial solve, in entries
+  for (int iteration = 0; iteration < ns && threads > 1; ++iteration) {
+    std::sort(open.begin(), open.end(), [&](int a, int b) { return subtree[a] > subtree[b]; });
+    std::vector<std::vector<int>> groups(threads);
+    std::vector<double> load(threads, 0.0);
+    for (int r : open) {
+      const int t = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+      groups[t].push_back(r);
+      load[t] += subtree[r];
+    }
+    const double time = top_work + *std::max_element(load.begin(), load.end());
+    if (time < best_time) {
+      best_time = time;
+      best_groups = groups;
+    }
+    if (open.empty() || top_work > 0.5 * total) break;
+    const int heaviest = open.front();
+    open.erase(open.begin());
+    is_top[heaviest] = 1;
+    top_work += work[heaviest];
+    open.insert(open.end(), children[heaviest].begin(), children[heaviest].end());
+  }
+
+  groups_.clear();
+  top_.clear();
+  std::vector<char> in_group(ns, 0);
+  for (const auto& g : best_groups) {
+    groups_.emplace_back();
+    for (int r : g) {
+      groups_.back().emplace_back(first[r], r);
+      for (int s = first[r]; s <= r; ++s) in_group[s] = 1;
+    }
+    std::sort(groups_.back().begin(), groups_.back().end());
+  }
+  if (groups_.empty()) groups_.emplace_back();  // one thread: everything is "top"
+  for (int s = 0; s < ns; ++s)
+    if (!in_group[s]) top_.push_back(s);
+  top_row_.assign(f.n, 0);
+  top_rows_.clear();
+  double top_entries = 0;
+  for (int s : top_) {
+    top_entries += work[s];
+    for (int k = f.super[s]; k < f.super[s + 1]; ++k) {
+      top_row_[k] = 1;
+      top_rows_.push_back(k);
+    }
+  }
+  top_fraction_ = total > 0 ? top_entries / total : 1;
+  acc_.assign(groups_.size(), std::vector<double>(f.n, 0.0));
+  work_.assign(groups_.size(), std::vector<double>(max_rows, 0.0));
+  y_.assign(f.n, 0.0);
+}
+
+void ParallelSubstitution::forward(int s, double* acc, double* w) {
+  const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1;
+  const int nsrow = L_.pi[s + 1] - L_.pi[s], nrest = nsrow - nscol;
+  const int* r = L_.rows + L_.pi[s] + nscol;
+  const double* Ls = L_.values + L_.px[s];
+  double* y = y_.data();
+  for (int j = 0; j < nscol; ++j) {  // the dense triangle
+    const double* col = Ls + static_cast<std::ptrdiff_t>(j) * nsrow;
+    const double xj = (y[k1 + j] /= col[j]);
+    for (int i = j + 1; i < nscol; ++i) y[k1 + i] -= col[i] * xj;
+  }
+  std::fill(w, w + nrest, 0.0);
+  for (int j = 0; j < nscol; ++j) {  // the rectangle below it
+    const double* off = Ls + static_cast<std::ptrdiff_t>(j) * nsrow + nscol;
+    const double xj = y[k1 + j];
+    for (int i = 0; i < nrest; ++i) w[i] += off[i] * xj;
+  }
+  if (acc) {  // top rows are shared between threads: collect their updates apart
+    for (int i = 0; i < nrest; ++i) {
+      if (top_row_[r[i]])
+        acc[r[i]] += w[i];
+      else
+        y[r[i]] -= w[i];
+    }
+  } else {
+    for (int i = 0; i < nrest; ++i) y[r[i]] -= w[i];
+  }
+}
+
+void ParallelSubstitution::backward(int s, double* w) {
+  const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1;
+  const int nsrow = L_.pi[s + 1] - L_.pi[s], nrest = nsrow - nscol;
+  const int* r = L_.rows + L_.pi[s] + nscol;
+  const double* Ls = L_.values + L_.px[s];
+  double* y = y_.data();
+  for (int i = 0; i < nrest; ++i) w[i] = y[r[i]];
+  for (int j = nscol - 1; j >= 0; --j) {
+    const double* col = Ls + static_cast<std::ptrdiff_t>(j) * nsrow;
+    const double t = y[k1 + j] - dot(col + nscol, w, nrest) - dot(col + j + 1, y + k1 + j + 1, nscol - j - 1);
+    y[k1 + j] = t / col[j];
+  }
+}
+
+void ParallelSubstitution::solve(const double* b, double* x) {
+  const int n = L_.n;
+  for (int k = 0; k < n; ++k) y_[k] = b[L_.perm[k]];
+  const int groups = static_cast<int>(groups_.size());
+#pragma omp parallel num_threads(groups) if (groups > 1)
+  {
+#ifdef _OPENMP
+    const int t = omp_get_thread_num();
+#else
+    const int t = 0;
+#endif
+    double* acc = acc_[t].data();
+    for (const auto& [a, z] : groups_[t])
+      for (int s = a; s <= z; ++s) forward(s, acc, work_[t].data());
+  }
+  for (int k : top_rows_)
+    for (int t = 0; t < groups; ++t) {
+      y_[k] -= acc_[t][k];
+      acc_[t][k] = 0.0;
+    }
+  for (int s : top_) forward(s, nullptr, work_[0].data());
+  for (auto it = top_.rbegin(); it != top_.rend(); ++it) backward(*it, work_[0].data());
+#pragma omp parallel num_threads(groups) if (groups > 1)
+  {
+#ifdef _OPENMP
+    const int t = omp_get_thread_num();
+#else
+    const int t = 0;
+#endif
+    for (auto g = groups_[t].rbegin(); g != groups_[t].rend(); ++g)
+      for (int s = g->second; s >= g->first; --s) backward(s, work_[t].data());
+  }
+  for (int k = 0; k < n; ++k) x[L_.perm[k]] = y_[k];
+}
+
+}  // namespace pfv

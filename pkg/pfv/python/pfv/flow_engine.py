@@ -29,6 +29,7 @@ __all__ = ["FlowEngine", "TimeStepWarning"]
 class TimeStepWarning(UserWarning):
     """O.dt exceeds the coupled stability limit (thesis 4.20-4.22)."""
 
+
 _engines = weakref.WeakValueDictionary()  # PyRunner commands find their engine here
 
 
@@ -64,7 +65,8 @@ _INTERNAL = frozenset({
     "_boundary_use_max_min", "_wall_ids", "_warned", "_vertex_of_id", "_threads",
     "_mass_per_diameter", "_dt_dem", "time_step_safety", "strict_time_step",
 })
-# YADE attributes PFV implements, with the core attribute they map to (or None if handled here).
+# YADE attributes PFV implements through a core attribute of another name (the others are
+# properties of FlowEngine below).
 _SUPPORTED = {
     "viscosity": "viscosity",
     "permeabilityFactor": "permeability_factor",
@@ -434,8 +436,4 @@ def _check_default(name, value):
     if not same:
         raise NotImplementedError(
             f"pfv.FlowEngine does not support YADE FlowEngine attribute '{name}' yet "
-            f"(only its default value {text_of(default)} is accepted)")
-
-
-def text_of(v):
-    return repr(v)
+            f"(only its default value {default!r} is accepted)")

@@ -101,6 +101,12 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
       steps_since_remesh_ = 0;
     } else {
       PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
+      // Free the old factor first (the largest object: peak memory is then one factor, not
+      // two). Should the new system fail, the old mesh is kept without a factor and the next
+      // step starts the remesh over; the last results stay readable meanwhile.
+      remesh_requested_ = true;
+      linear_.cholmod = std::make_unique<CholmodSolver>();
+      linear_.pcg = PcgSolver{};
       LinearSystem l = build_linear_system(m, bc, settings, dt);
       adopt(std::move(m), std::move(l), bc_version_);
       strain_ = 0;

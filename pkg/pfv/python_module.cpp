@@ -114,6 +114,26 @@ PYBIND11_MODULE(_core, m) {
     }
   });
 
+  // Sphere centres straight from YADE's coordinate lists (yade._utils.coordsAndDisplacements
+  // returns one Python list per axis, all bodies): no numpy round trip.
+  m.def("gather_positions", [](const py::list& xs, const py::list& ys, const py::list& zs,
+                               const py::array_t<long long>& rows) {
+    const auto r = rows.unchecked<1>();
+    Array out({r.shape(0), py::ssize_t{3}});
+    auto o = out.mutable_unchecked<2>();
+    const py::ssize_t n = PyList_GET_SIZE(xs.ptr());
+    if (PyList_GET_SIZE(ys.ptr()) != n || PyList_GET_SIZE(zs.ptr()) != n) throw py::value_error("coordinate lists differ in length");
+    for (py::ssize_t i = 0; i < r.shape(0); ++i) {
+      const py::ssize_t row = r(i);
+      if (row < 0 || row >= n) throw py::index_error("body row out of range (bodies changed?)");
+      o(i, 0) = PyFloat_AsDouble(PyList_GET_ITEM(xs.ptr(), row));
+      o(i, 1) = PyFloat_AsDouble(PyList_GET_ITEM(ys.ptr(), row));
+      o(i, 2) = PyFloat_AsDouble(PyList_GET_ITEM(zs.ptr(), row));
+    }
+    if (PyErr_Occurred()) throw py::error_already_set();
+    return out;
+  });
+
   py::class_<FlowEngine>(m, "Engine")
       .def(py::init<>())
       // Settings.

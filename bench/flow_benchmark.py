@@ -5,6 +5,10 @@ Run with YADE (the driver re-invokes yade-double on this file for every measurem
     yade-double -n -x bench/flow_benchmark.py [--quick] [--sizes=1000,10000,50000] [--rounds=3]
                 [--threads=1,2] [--out=doc/benchmarks.md] [--json=FILE] [--no-memory] [--no-oedometer]
                 [--oedo-sizes=1000,10000] [--oedo-steps=600] [--oedo-interval=200] [--steady=20]
+                [--gen-threads=T]    (threads of the child that generates a missing packing; default max of --threads)
+
+--quick: 300 spheres, 1 round, -j1, 10 steady steps, oedometer 60 steps with a remesh every 20, report written to
+/tmp/bench/benchmarks-quick.md unless --out is given (tests/yade/test_bench_quick.py runs it).
 
 What it does
   1. Packings: dense packings of N spheres (N in --sizes) in a cube of side (N/1000)^(1/3) (so the sphere size does not
@@ -13,8 +17,9 @@ What it does
      $PFV_CACHE_DIR or ~/.cache/pfv (bench_packing_v1_n<N>_s1.txt).  Every scene below is built from that file.
   2. Timing (one yade process per thread count, `yade-double -jT`): for each N the permeameter scene (the packing,
      six fixed walls, spheres *dynamic* (no blocked DOFs), friction 30 deg, no gravity, pressure drop 100 Pa along y =
-     1 % of the confining stress, viscosity 1e-3, O.dt = 0.5 P-wave step) is saved once with O.saveTmp and every
-     trial starts from it.  Trials are interleaved YADE / PFV / dry, rotating the order every round.  A trial runs
+     1 % of the confining stress, viscosity 1e-3, O.dt = 0.5 P-wave step, slipBoundary=False in both engines) is
+     settled (damping 0.5 until the unbalanced force is < 0.01: the file has no contact history), saved once with
+     O.saveTmp, and every trial starts from it.  Trials are interleaved YADE / PFV / dry, rotating the order every round.  A trial runs
      W=3 first steps, S steady steps, a forced remesh (updateTriangulation=True) followed by W steps, and 3 more steps,
      timing every O.step() (wall clock) and the engine's execTime (O.timingEnabled).  Both engines use CHOLMOD
      (useSolver=3), meshUpdateInterval=1e9, defTolerance=0, everything else at its default.
@@ -22,7 +27,9 @@ What it does
      resetting it through /proc/self/clear_refs) and VmRSS after a first step, S steady steps and a forced remesh.
   4. Oedometer (coupled/dry cost ratio): the packing with the top wall under a TriaxialStressController (stressMask=2,
      load step 10 -> 11 kPa), drained top, impermeable other walls, viscosity 10, meshUpdateInterval=200,
-     defTolerance=0.3 (as in YADE's examples/FluidCouplingPFV/oedometer.py), O.run(M) timed for YADE, PFV and dry.
+     defTolerance=0.3, O.dt=1e-4 (as in YADE's examples/FluidCouplingPFV/oedometer.py), O.run(M) timed for YADE,
+     PFV and dry, interleaved like the trials.
+  Children run with OPENBLAS_NUM_THREADS = OMP_NUM_THREADS = T (Debian's OpenBLAS would use every core otherwise).
 
 Definitions (medians over rounds of per-trial medians)
   flow step   : engine execTime of a steady step (no remesh)
@@ -239,7 +246,7 @@ def generate_packing(n):
 # ---------------------------------------------------------------------------------------------------------------
 # scenes
 # ---------------------------------------------------------------------------------------------------------------
-def build_scene(n, oedometer=False):
+def build_scene(n, oedometer=False, settle=True):
     """Build the scene from the cached packing in a reset O. Returns info dict."""
     from yade import O, utils
     from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,
@@ -274,8 +281,21 @@ def build_scene(n, oedometer=False):
     # step, about 9e-4, with either engine).
     O.dt = OEDO_DT if oedometer else 0.5 * utils.PWaveTimeStep()
     O.dynDt = False
-    O.run(20, True)   # contacts exist and the first collider pass is done before any measurement
-    return dict(n=n, box=L, digest=packing_digest(spheres), meta=meta, dt=O.dt, bodies=len(O.bodies))
+    # Settle: the file has no contact history (the shear forces of the compaction are lost, unbalanced force ~0.05
+    # after rebuilding); relax with damping 0.5 until the unbalanced force is below 0.01 so that the steps measured
+    # are quasi-static.  The first collider pass and the contact creation also happen here.
+    newton = O.engines[-1]
+    newton.damping = 0.5
+    steps = 0
+    while True:
+        O.run(50, True)
+        steps += 50
+        unb = utils.unbalancedForce()
+        if not settle or unb < 0.01 or steps >= 1000:
+            break
+    newton.damping = 0.0 if oedometer else 0.2
+    return dict(n=n, box=L, digest=packing_digest(spheres), meta=meta, dt=O.dt, bodies=len(O.bodies),
+                settle_steps=steps, unbalanced=unb)
 
 
 def make_engine(kind, oedometer=False, oedo_interval=200):
@@ -437,8 +457,10 @@ def run_trial(kind, info, steady, warnings_seen):
             first['remesh_times'] = dict(flow.core.remesh_times())
         st = dict(wall=[], exec=[])
         td1 = _yade_td(flow)
+        c0, w0 = time.process_time(), time.perf_counter()
         for _ in range(steady):
             step(st)
+        st['cpu_share'] = (time.process_time() - c0) / (time.perf_counter() - w0)
         td2 = _yade_td(flow)
         flow.updateTriangulation = True
         rem = dict(wall=[], exec=[])
@@ -524,14 +546,15 @@ def oedometer_trial(kind, n, steps, interval):
 
 def timing_child(opts):
     from yade import O
-    out = dict(threads=O.numThreads, sizes={}, oedometer={}, warnings=[])
+    out = dict(threads=O.numThreads, sizes={}, oedometer={}, warnings=[], load_start=os.getloadavg())
     rounds = opts['rounds']
     for n in opts['sizes']:
         info = build_scene(n)
         O.saveTmp('bench')
         steady = opts['steady'] if n <= 20000 else max(5, opts['steady'] // 2)
-        log('timing n=%d (%d bodies, dt %.3g) threads=%d, %d rounds, %d steady steps'
-            % (n, info['bodies'], info['dt'], O.numThreads, rounds, steady))
+        log('timing n=%d (%d bodies, dt %.3g, settled in %d steps to unbalanced force %.3g) threads=%d, %d rounds, '
+            '%d steady steps' % (n, info['bodies'], info['dt'], info['settle_steps'], info['unbalanced'], O.numThreads,
+                                 rounds, steady))
         trials = dict(yade=[], pfv=[], dry=[])
         order = ['yade', 'pfv', 'dry']
         for r in range(rounds):
@@ -559,6 +582,7 @@ def timing_child(opts):
                     log('  oedometer n=%d round %d %-4s %.2f s' % (n, r + 1, kind, res['seconds']))
             out['oedometer'][str(n)] = dict(trials=trials, steps=opts['oedo_steps'], interval=opts['oedo_interval'])
             O.reset()
+    out['load_end'] = os.getloadavg()
     return out
 
 
@@ -568,7 +592,7 @@ def timing_child(opts):
 def memory_child(opts):
     from yade import O
     n, kind = opts['size'], opts['engine']
-    build_scene(n)
+    build_scene(n, settle=False)
     gc.collect()
     before = rss_kb()
     exact = reset_peak()
@@ -577,12 +601,17 @@ def memory_child(opts):
         insert_engine(flow)
     for _ in range(WINDOW + opts['steady']):
         O.step()
+    peak_first, mid = rss_kb('VmHWM'), rss_kb()
+    reset_peak()
     if kind != 'dry':
         flow.updateTriangulation = True
     for _ in range(WINDOW):
         O.step()
-    peak, after = rss_kb('VmHWM'), rss_kb()
-    return dict(n=n, kind=kind, rss_before_kb=before, peak_kb=peak, rss_after_kb=after, peak_reset=exact,
+    peak_remesh, after = rss_kb('VmHWM'), rss_kb()
+    if not exact:
+        peak_remesh = max(peak_remesh, peak_first)
+    return dict(n=n, kind=kind, rss_before_kb=before, peak_kb=max(peak_first, peak_remesh), peak_first_kb=peak_first,
+                rss_mid_kb=mid, peak_remesh_kb=peak_remesh, rss_after_kb=after, peak_reset=exact,
                 threads=O.numThreads)
 
 
@@ -697,6 +726,7 @@ def summarise(timing, memory):
                     remesh.append(sum(x['remesh']['exec']) - (WINDOW - 1) * fs)
                     first.append(sum(x['first']['exec']) - (WINDOW - 1) * fs)
                 row[kind] = dict(flow=median(flow_step), remesh=median(remesh), first=median(first),
+                                 cpu_share=median([x['steady'].get('cpu_share') for x in tr[kind]]),
                                  coupled=median(coupled), flow_range=(min(flow_step), max(flow_step)),
                                  remesh_range=(min(remesh), max(remesh)),
                                  cells=tr[kind][0]['n_cells'] if tr[kind] else None)
@@ -712,12 +742,12 @@ def summarise(timing, memory):
                                         flux_yade=fy, flux_pfv=fp,
                                         probe_yade=py[13], probe_pfv=pp[13])
             # PFV breakdown
-            rem_stages = ('triangulation', 'geometry', 'conductance', 'assembly', 'factorization', 'force_cache')
             step_stages = ('volumes', 'solve', 'forces')
             br = {'remesh': {}, 'steady': {}}
             per_trial_r, per_trial_s = [], []
             for x in tr['pfv']:
                 rt = x['remesh']['remesh_times']
+                rem_stages = [k2 for k2 in rt if k2 not in step_stages]  # whatever stages the core reports
                 counts = x['remesh'].get('remesh_count', [])
                 base = x['first']['remesh_count'][-1] if x['first'].get('remesh_count') else None
                 # the window step in which PFV remeshed
@@ -775,7 +805,7 @@ def summarise(timing, memory):
                                settlement=tr[kind][0].get('settlement'))
             r['dry_settlement'] = tr['dry'][0]['settlement'] if tr['dry'] else None
             oe[ns] = r
-        summ[t] = dict(sizes=st, oedometer=oe)
+        summ[t] = dict(sizes=st, oedometer=oe, load=(data.get('load_start'), data.get('load_end')))
     mem = {}
     for m in memory:
         mem.setdefault(str(m['n']), {})[m['kind']] = m
@@ -844,7 +874,7 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
     w('Scene: permeameter along y (dp = %g Pa, viscosity %g, p = 0 at ymax), six fixed walls (boundaries at the walls),'
       ' dynamic spheres with friction 30 deg, Newton damping 0.2, no gravity, O.dt = 0.5 P-wave step; the packing is '
       'at equilibrium under 10 kPa, so the drag (1 %% of the confinement) hardly moves it.  Both engines: CHOLMOD '
-      '(useSolver=3), no automatic remesh (meshUpdateInterval=1e9, defTolerance=0); other attributes at their '
+      '(useSolver=3), slipBoundary=False, no automatic remesh (meshUpdateInterval=1e9, defTolerance=0); other attributes at their '
       'defaults (YADE: multithread=False).' % (DP, VISCOSITY))
     w('')
     for t in sorted(summ, key=int):
@@ -871,23 +901,47 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
                 fmt_t(sizes[ns]['pfv']['flow_range'][0]), fmt_t(sizes[ns]['pfv']['flow_range'][1]))
             for ns in sorted(sizes, key=int)) + '.')
         w('')
+        ld = summ[t].get('load') or (None, None)
+        if ld[0]:
+            w('Load average (1, 5, 15 min) of the machine when this yade process started: %s; when it ended: %s.  '
+              'CPU time / wall time of the steady steps (1 = one core fully ours%s): %s.'
+              % (' '.join('%.2f' % v for v in ld[0]), ' '.join('%.2f' % v for v in ld[1]),
+                 '' if t == '1' else ', up to %s with %s threads' % (t, t),
+                 '; '.join('N=%s YADE %.2f PFV %.2f' % (ns, sizes[ns]['yade'].get('cpu_share') or float('nan'),
+                                                       sizes[ns]['pfv'].get('cpu_share') or float('nan'))
+                           for ns in sorted(sizes, key=int))))
+            w('')
+        w('Scene before the trials (settled with damping 0.5): ' + '; '.join(
+            'N=%s: %s steps, unbalanced force %.3g, dt %.3g s' % (ns, sizes[ns]['info'].get('settle_steps'),
+                                                            sizes[ns]['info'].get('unbalanced', float('nan')),
+                                                            sizes[ns]['info']['dt']) for ns in sorted(sizes, key=int)) + '.')
+        w('')
     if mem:
         w('### Peak memory (fresh `yade-double -j1` per engine; growth over the scene without engine)')
         w('')
-        w('| N | scene RSS | dry peak growth | YADE peak growth | PFV peak growth | P/Y (net of dry) | YADE retained | PFV retained |')
-        w('|---|---|---|---|---|---|---|---|')
+        w('| N | scene RSS | dry peak growth | YADE peak growth | PFV peak growth | P/Y (net of dry) | YADE retained | PFV retained '
+          '| YADE peak first mesh / forced remesh | PFV peak first mesh / forced remesh |')
+        w('|---|---|---|---|---|---|---|---|---|---|')
         for ns in sorted(mem, key=int):
             m = mem[ns]
             g = {k: m[k]['peak_kb'] - m[k]['rss_before_kb'] for k in m}
             ret = {k: m[k]['rss_after_kb'] - m[k]['rss_before_kb'] for k in m}
             d = g.get('dry', 0)
-            w('| %s | %s | %s | %s | %s | **%s** | %s | %s |'
+            def split(k):
+                x = m.get(k, {})
+                if 'peak_first_kb' not in x:
+                    return 'n/a'
+                return '%s / %s' % (fmt_mb(x['peak_first_kb'] - x['rss_before_kb']),
+                                    fmt_mb(x['peak_remesh_kb'] - x['rss_before_kb']))
+            w('| %s | %s | %s | %s | %s | **%s** | %s | %s | %s | %s |'
               % (ns, fmt_mb(m.get('dry', m.get('yade'))['rss_before_kb']), fmt_mb(g.get('dry')), fmt_mb(g.get('yade')),
                  fmt_mb(g.get('pfv')), fmt_r(g.get('pfv', 0) - d, g.get('yade', 0) - d), fmt_mb(ret.get('yade')),
-                 fmt_mb(ret.get('pfv'))))
+                 fmt_mb(ret.get('pfv')), split('yade'), split('pfv')))
         exact = all(m[k]['peak_reset'] for m in mem.values() for k in m)
         w('')
-        w('Peak = VmHWM %s minus VmRSS before the engine was added; retained = VmRSS after minus before.'
+        w('Peak = VmHWM %s minus VmRSS before the engine was added (the larger of the first-mesh phase: first step + '
+          'steady steps, and of the forced-remesh phase, the high-water mark being reset in between); retained = VmRSS '
+          'at the end minus before.'
           % ('after a reset through /proc/self/clear_refs' if exact else '(could NOT be reset: includes scene building)'))
         w('')
     w('### Pressure agreement (PFV vs YADE, same scene, same step)')
@@ -970,7 +1024,7 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
     w('')
     w('PFV stage time per sphere (us/sphere), fitted exponent b of t ~ N^b, and the thesis fit evaluated at the same N '
       '(Xeon 2.67 GHz, 2011, sequential).  Mapping: triangulation = T_TRG, geometry + conductance = T_G, '
-      'assembly + factorization = T_LTL (the thesis includes reordering), force_cache = T_F, volumes = T_DEF, '
+      'assembly + analysis (ordering) + factorization = T_LTL, force_cache = T_F, volumes = T_DEF, '
       'solve = T_SLV, forces = T_Fcache.')
     w('')
     w('| stage | ' + ' | '.join('PFV us/sph N=%s' % ns for ns in ns_list) + ' | b (PFV) | ' +
@@ -984,7 +1038,7 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
         if name == 'geometry+conductance':
             return r.get('geometry', 0) + r.get('conductance', 0)
         if name == 'assembly+factorization':
-            return r.get('assembly', 0) + r.get('factorization', 0)
+            return r.get('assembly', 0) + r.get('analysis', 0) + r.get('factorization', 0)
         if name in r:
             return r[name]
         return s.get(name)
@@ -1098,6 +1152,11 @@ def driver(opts, argv):
                                          '--steady=%d' % opts['steady']] + (['--quick'] if opts['quick'] else []),
                                         1, 'memory-%s-%d' % (kind, n)))
     finished = datetime.datetime.now().strftime('%Y-%m-%d %H:%M')
+    builds = sorted(set(d.get('pfv_build') for d in list(timing.values()) + memory if d.get('pfv_build')))
+    machine['pfv extension'] = ' | '.join(builds) + (' -- WARNING: the children used different pfv builds '
+                                                     '(pfv was reinstalled during the run)' if len(builds) > 1 else '')
+    if len(builds) > 1:
+        log('WARNING: pfv was reinstalled during the run: %s' % builds)
     machine['load average at end'] = ' '.join('%.2f' % x for x in os.getloadavg())
     summ, mem = summarise(timing, memory)
     text = report(opts, machine, {n: packings[n] for n in opts['sizes']}, summ, mem, command, started, finished)
@@ -1130,9 +1189,23 @@ def main(argv):
         traceback.print_exc()
         sys.stdout.flush()
         return 1
+    data['pfv_build'] = pfv_fingerprint()
     with open(opts['child_json'], 'w') as f:
         json.dump(data, f, default=str)
     return 0
+
+
+def pfv_fingerprint():
+    """Where the pfv extension module loaded by this process lives and when it was built: colleagues may reinstall
+    pfv while a long benchmark runs; the driver reports it if its children did not all use the same build."""
+    mod = sys.modules.get('pfv._core')
+    if mod is None:
+        return None
+    path = getattr(mod, '__file__', '?')
+    try:
+        return '%s (modified %s)' % (path, datetime.datetime.fromtimestamp(os.path.getmtime(path)).isoformat(' ', 'seconds'))
+    except OSError:
+        return path
 
 
 if __name__ == '__main__' and 'yade' in sys.modules:

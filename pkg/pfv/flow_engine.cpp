@@ -201,6 +201,67 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   has_prev_ = true;
 }
 
+double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations) const {
+  if (!has_mesh() || !has_prev_) throw std::logic_error("the stability limit needs a mesh: run a step first");
+  const int n = mesh().n_spheres, nc = mesh().n_cells();
+  if (static_cast<int>(mass.size()) != n) bad_input("one mass per sphere is needed");
+  const PressureSystem& system = linear_.system;
+  const int nu = system.n_unknowns();
+  const bool direct = linear_.cholmod->ready();
+  if (nu == 0 || (!direct && !linear_.pcg.ready() && settings.use_solver != 0)) return HUGE_VAL;
+
+  // Velocity probe: unit norm over the moving spheres, deterministic start.
+  std::vector<Vec3> v(n, Vec3::Zero()), shifted(centres_prev_);
+  double norm = 0;
+  for (int k = 0; k < n; ++k)
+    if (mass[k] > 0) {
+      v[k] = Vec3(std::sin(1.0 + 3.1 * k), std::cos(2.0 + 1.7 * k), std::sin(0.5 + 2.3 * k));
+      norm += v[k].squaredNorm();
+    }
+  if (norm == 0) return HUGE_VAL;
+  double h = 0;  // probe displacement: a tiny fraction of the box
+  for (int a = 0; a < 3; ++a) h = std::max(h, walls_prev_.extent(a));
+  h *= 1e-7;
+  std::vector<double> rhs(nu), x, p_cells(nc, 0.0), gs_p;
+  std::vector<Vec3> force;
+  double lambda = 0;
+  for (int it = 0; it < iterations; ++it) {
+    norm = 0;
+    for (const Vec3& u : v) norm += u.squaredNorm();
+    norm = std::sqrt(norm);
+    for (Vec3& u : v) u /= norm;
+    // dV/dt for unit velocity v, by central differences (cell volumes are smooth in x).
+    for (int u = 0; u < nu; ++u) {
+      const int c = system.unknown_cell[u];
+      const CellShape& shape = mesh_->cells.shape[c];
+      for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = centres_prev_[shape.v[k]] + h * v[shape.v[k]];
+      const double plus = cell_volume(shape, shifted, walls_prev_);
+      for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = centres_prev_[shape.v[k]] - h * v[shape.v[k]];
+      const double minus = cell_volume(shape, shifted, walls_prev_);
+      for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = centres_prev_[shape.v[k]];
+      rhs[u] = -(plus - minus) / (2 * h);
+    }
+    if (direct) {
+      const_cast<CholmodSolver&>(*linear_.cholmod).solve(rhs, x);
+    } else {  // the iterative solvers, to a tight tolerance
+      gs_p.assign(nc, 0.0);
+      gauss_seidel(system, rhs, gs_p, 1e-10, settings.relax, settings.max_gs_iterations);
+      x.resize(nu);
+      for (int u = 0; u < nu; ++u) x[u] = gs_p[system.unknown_cell[u]];
+    }
+    for (int u = 0; u < nu; ++u) p_cells[system.unknown_cell[u]] = x[u];
+    mesh_->cache.apply(p_cells, force);
+    double a_norm = 0;
+    for (int k = 0; k < n; ++k) {
+      v[k] = mass[k] > 0 ? Vec3(force[k] / mass[k]) : Vec3::Zero();
+      a_norm += v[k].squaredNorm();
+    }
+    lambda = std::sqrt(a_norm);  // |M^-1 V v| for |v| = 1
+    if (lambda == 0) return HUGE_VAL;
+  }
+  return 2.0 / lambda;
+}
+
 double FlowEngine::boundary_flux(int wall) const {
   const PressureSystem& s = linear_.system;
   double q = 0;

@@ -242,6 +242,11 @@ PYBIND11_MODULE(_core, m) {
              py::gil_scoped_release release;
              e.step(c, r, w, dt);
            }, py::arg("positions"), py::arg("radii"), py::arg("walls"), py::arg("dt"))
+      .def("viscous_stability_limit", [](const FlowEngine& e, const Array& mass, int iterations) {
+             auto m = to_vector(mass, "masses");
+             py::gil_scoped_release release;
+             return e.viscous_stability_limit(m, iterations);
+           }, py::arg("masses"), py::arg("iterations") = 40)
       .def("forces", [](const FlowEngine& e) { return points_to_array(e.forces()); },
            "Fluid force on every sphere (input order), then on the six walls.")
       .def("pressure", [](const FlowEngine& e) { return vector_to_array(e.pressure()); })

@@ -263,11 +263,15 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
 }
 
 double FlowEngine::boundary_flux(int wall) const {
+  // Fluid leaving through the wall: what flows into its Dirichlet cells from the rest of the
+  // pore space, plus what those cells expel themselves as they shrink (a moving drained wall
+  // sweeps their volume). Without deformation only the first term remains.
   const PressureSystem& s = linear_.system;
   double q = 0;
   for (std::size_t c = 0; c < s.source.size(); ++c) {
     if (s.source[c] != wall) continue;
     for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e) q += s.adj_k[e] * (pressure_[s.adj_cell[e]] - pressure_[c]);
+    if (c < volume_rate_.size()) q -= volume_rate_[c];
   }
   return q;
 }
@@ -282,7 +286,7 @@ double FlowEngine::imposed_flux_total() const {
 
 double FlowEngine::volume_rate_total() const {
   double s = 0;
-  for (int c : linear_.system.unknown_cell) s += volume_rate_[c];
+  for (double r : volume_rate_) s += r;
   return s;
 }
 

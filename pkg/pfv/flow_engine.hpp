@@ -65,7 +65,7 @@ class FlowEngine {
   const BoxWalls& walls() const { return walls_prev_; }
   double boundary_flux(int wall) const;
   double imposed_flux_total() const;
-  double volume_rate_total() const;  // sum of dV/dt over the unknown cells
+  double volume_rate_total() const;  // sum of dV/dt over all cells
   double average_pressure() const;
   double average_slice_pressure(int axis, double position) const;
   int locate(const Vec3& x) const { return mesh_ ? mesh_->tri.locate(x) : -1; }

@@ -23,6 +23,14 @@ inline double dot(const double* a, const double* b, int n) {
   return (s0 + s1) + (s2 + s3);
 }
 
+inline int thread_index() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
 }  // namespace
 
 void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
@@ -166,11 +174,7 @@ void ParallelSubstitution::solve(const double* b, double* x) {
   const int groups = static_cast<int>(groups_.size());
 #pragma omp parallel num_threads(groups) if (groups > 1)
   {
-#ifdef _OPENMP
-    const int t = omp_get_thread_num();
-#else
-    const int t = 0;
-#endif
+    const int t = thread_index();
     double* acc = acc_[t].data();
     for (const auto& [a, z] : groups_[t])
       for (int s = a; s <= z; ++s) forward(s, acc, work_[t].data());
@@ -184,11 +188,7 @@ void ParallelSubstitution::solve(const double* b, double* x) {
   for (auto it = top_.rbegin(); it != top_.rend(); ++it) backward(*it, work_[0].data());
 #pragma omp parallel num_threads(groups) if (groups > 1)
   {
-#ifdef _OPENMP
-    const int t = omp_get_thread_num();
-#else
-    const int t = 0;
-#endif
+    const int t = thread_index();
     for (auto g = groups_[t].rbegin(); g != groups_[t].rend(); ++g)
       for (int s = g->second; s >= g->first; --s) backward(s, work_[t].data());
   }

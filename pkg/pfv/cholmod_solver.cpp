@@ -5,7 +5,9 @@
 #include <omp.h>
 #endif
 
+#include <cfloat>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -43,6 +45,7 @@ void CholmodSolver::release() {
       *d = nullptr;
     }
   factor_ = nullptr;
+  std::vector<float>().swap(values32_);
   parallel_ = ParallelSubstitution{};  // it points into the factor just freed
 }
 
@@ -54,7 +57,28 @@ double CholmodSolver::factor_flops() const {
   return factor_ ? common_->c.fl : 0.0;
 }
 
-void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering) {
+namespace {
+
+// A view of the assembled arrays; CHOLMOD only reads them.
+cholmod_sparse view_of(const PressureSystem& s) {
+  cholmod_sparse a{};
+  a.nrow = a.ncol = s.n_unknowns();
+  a.nzmax = s.value.size();
+  a.p = const_cast<int*>(s.col_start.data());
+  a.i = const_cast<int*>(s.row.data());
+  a.x = const_cast<double*>(s.value.data());
+  a.stype = 1;  // upper triangle stored
+  a.itype = CHOLMOD_INT;
+  a.xtype = CHOLMOD_REAL;
+  a.dtype = CHOLMOD_DOUBLE;
+  a.sorted = 1;
+  a.packed = 1;
+  return a;
+}
+
+}  // namespace
+
+void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, FactorPrecision precision) {
   release();
   cholmod_common* c = &common_->c;
   const int n = s.n_unknowns();
@@ -68,26 +92,42 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering) {
                             : ordering == Ordering::kMetis ? CHOLMOD_METIS
                                                            : CHOLMOD_NESDIS;
   }
-  // A view of the assembled arrays; CHOLMOD only reads them.
-  cholmod_sparse a{};
-  a.nrow = a.ncol = n;
-  a.nzmax = s.value.size();
-  a.p = const_cast<int*>(s.col_start.data());
-  a.i = const_cast<int*>(s.row.data());
-  a.x = const_cast<double*>(s.value.data());
-  a.stype = 1;  // upper triangle stored
-  a.itype = CHOLMOD_INT;
-  a.xtype = CHOLMOD_REAL;
-  a.dtype = CHOLMOD_DOUBLE;
-  a.sorted = 1;
-  a.packed = 1;
-
+  cholmod_sparse a = view_of(s);
   const auto t0 = std::chrono::steady_clock::now();
   cholmod_factor* f = cholmod_analyze(&a, c);
   analysis_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!f) throw std::runtime_error("CHOLMOD analysis failed (status " + std::to_string(c->status) + ")");
   factor_ = f;
   metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
+  numeric_factorization(s);
+  rhs_ = cholmod_zeros(n, 1, CHOLMOD_REAL, c);
+
+  if (precision == FactorPrecision::kSingle && f->is_super && f->is_ll) {
+    const auto* x = static_cast<const double*>(f->x);
+    const std::size_t count = static_cast<const int*>(f->px)[f->nsuper];
+    values32_.resize(count);
+    bool representable = true;
+    for (std::size_t i = 0; i < count; ++i) {
+      const float v = static_cast<float>(x[i]);
+      representable = representable && std::isfinite(v) && (x[i] == 0 || std::abs(v) >= FLT_MIN);
+      values32_[i] = v;
+    }
+    if (representable) {
+      // Keep the symbolic supernodal structure (super, pi, px, s, Perm), free the doubles.
+      cholmod_change_factor(CHOLMOD_PATTERN, true, true, true, true, f, c);
+      if (f->x != nullptr || !f->is_super) throw std::logic_error("CHOLMOD kept the numeric factor");
+    } else {
+      std::vector<float>().swap(values32_);
+    }
+  }
+  plan_substitution();
+}
+
+void CholmodSolver::numeric_factorization(const PressureSystem& s) {
+  cholmod_common* c = &common_->c;
+  auto* f = static_cast<cholmod_factor*>(factor_);
+  const int n = s.n_unknowns();
+  cholmod_sparse a = view_of(s);
   cholmod_factorize(&a, f, c);
   if (c->status == CHOLMOD_NOT_POSDEF || f->minor < static_cast<size_t>(n)) {
     const auto minor = f->minor;
@@ -99,33 +139,53 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering) {
     release();
     throw std::runtime_error("CHOLMOD factorisation failed (status " + std::to_string(c->status) + ")");
   }
-  rhs_ = cholmod_zeros(n, 1, CHOLMOD_REAL, c);
-  if (f->is_super && f->is_ll) {
-    SupernodalFactor view;
-    view.n = n;
-    view.nsuper = static_cast<int>(f->nsuper);
-    view.super = static_cast<const int*>(f->super);
-    view.pi = static_cast<const int*>(f->pi);
-    view.px = static_cast<const int*>(f->px);
-    view.rows = static_cast<const int*>(f->s);
-    view.perm = static_cast<const int*>(f->Perm);
+}
+
+void CholmodSolver::promote_to_double(const PressureSystem& s) {
+  if (!factor_ || !single_precision()) return;
+  std::vector<float>().swap(values32_);
+  numeric_factorization(s);  // on the symbolic factor kept from the analysis
+  plan_substitution();
+}
+
+void CholmodSolver::plan_substitution() {
+  const auto* f = static_cast<const cholmod_factor*>(factor_);
+  if (!f->is_super || !f->is_ll) return;
+  SupernodalFactor view;
+  view.n = static_cast<int>(f->n);
+  view.nsuper = static_cast<int>(f->nsuper);
+  view.super = static_cast<const int*>(f->super);
+  view.pi = static_cast<const int*>(f->pi);
+  view.px = static_cast<const int*>(f->px);
+  view.rows = static_cast<const int*>(f->s);
+  view.perm = static_cast<const int*>(f->Perm);
+  if (single_precision())
+    view.values32 = values32_.data();
+  else
     view.values = static_cast<const double*>(f->x);
-    parallel_.plan(view, 2);
-  }
+  parallel_.plan(view, 2);
 }
 
 void CholmodSolver::solve(const std::vector<double>& rhs, std::vector<double>& x) {
 #ifdef _OPENMP
-  if (factor_ && parallel_.threads() > 1 && omp_get_max_threads() > 1) {
+  const bool threads = omp_get_max_threads() > 1;
+#else
+  const bool threads = false;
+#endif
+  if (factor_ && (single_precision() || (threads && parallel_.threads() > 1))) {
     x.resize(rhs.size());
-    parallel_.solve(rhs.data(), x.data());
+    parallel_.solve(rhs.data(), x.data(), threads);
     return;
   }
-#endif
   solve_serial(rhs, x);
 }
 
 void CholmodSolver::solve_serial(const std::vector<double>& rhs, std::vector<double>& x) {
+  if (single_precision()) {
+    x.resize(rhs.size());
+    parallel_.solve(rhs.data(), x.data(), false);
+    return;
+  }
   if (!factor_) {
     x.clear();
     return;

@@ -13,6 +13,11 @@ struct PressureSystem;
 // Fill-reducing ordering. kAuto is CHOLMOD's default (AMD, then METIS if AMD fills badly).
 enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
 
+// kSingle keeps the factor, computed in double, rounded to float (CHOLMOD's double values are
+// freed): half the memory and half the memory traffic of a substitution, whose result is then
+// only an approximate inverse, to be used inside iterative refinement (refinement.hpp).
+enum class FactorPrecision { kDouble, kSingle };
+
 class CholmodSolver {
  public:
   CholmodSolver();
@@ -20,12 +25,20 @@ class CholmodSolver {
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
 
-  // Throws std::domain_error if G is not positive definite.
-  void factorize(const PressureSystem& system, Ordering ordering);
+  // Throws std::domain_error if G is not positive definite. A single-precision request falls
+  // back to double when an entry of the factor is out of float's normal range.
+  void factorize(const PressureSystem& system, Ordering ordering,
+                 FactorPrecision precision = FactorPrecision::kDouble);
+  // Refactorises in double on the same ordering (no new analysis): for when refinement with
+  // the rounded factor does not converge (G too ill-conditioned for float).
+  void promote_to_double(const PressureSystem& system);
+  // x ~ G^-1 rhs; exact to round-off in double, to about cond(G) * 6e-8 in single precision.
   // With two or more OpenMP threads the substitutions run on subtrees in parallel
-  // (parallel_substitution.hpp); with one, CHOLMOD's own (BLAS-based) solve is used.
+  // (parallel_substitution.hpp); with one, CHOLMOD's own (BLAS-based) solve is used in double
+  // and the same subtree plan, run serially, in single precision.
   void solve(const std::vector<double>& rhs, std::vector<double>& x);
   void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
+  bool single_precision() const { return !values32_.empty(); }
   double parallel_top_fraction() const { return parallel_.top_fraction(); }
   bool metis_used() const { return metis_used_; }
   bool ready() const { return factor_ != nullptr; }
@@ -35,6 +48,8 @@ class CholmodSolver {
 
  private:
   void release();
+  void numeric_factorization(const PressureSystem& system);
+  void plan_substitution();
   struct Common;
   Common* common_;
   void* factor_ = nullptr;  // cholmod_factor*
@@ -42,6 +57,7 @@ class CholmodSolver {
   void* x_ = nullptr;
   void* work_y_ = nullptr;
   void* work_e_ = nullptr;
+  std::vector<float> values32_;  // the factor's values in single precision, or empty
   ParallelSubstitution parallel_;
   bool metis_used_ = false;
   double analysis_seconds_ = 0;

@@ -14,6 +14,13 @@ struct EngineSettings {
   int max_gs_iterations = 200000;
   bool force_metis = false;  // YADE's forceMetis: METIS ordering whatever 'ordering' says
   Ordering ordering = Ordering::kAuto;
+  // useSolver 3 only: keep the Cholesky factor in single precision and refine each solve in
+  // double from the previous pressures (refinement.hpp) until the estimated error is below
+  // refinement_tolerance * max|p|. Falls back to the double factor if G is too
+  // ill-conditioned for float.
+  bool mixed_precision = false;
+  double refinement_tolerance = 1e-10;
+  int max_refinement_passes = 8;
   int mesh_update_interval = 1000;
   double def_tolerance = 0;  // YADE's default: no strain-triggered remesh
   double p_zero = 0;

@@ -115,7 +115,8 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     }
   }
   const bool solver_missing = linear_.system.n_unknowns() > 0 &&
-                              ((settings.use_solver == 3 && !linear_.cholmod->ready()) ||
+                              ((settings.use_solver == 3 && (!linear_.cholmod->ready() ||
+                                                             linear_.mixed_precision != settings.mixed_precision)) ||
                                (settings.use_solver == 1 && !linear_.pcg.ready()));
   const bool storage_stale = (settings.fluid_bulk_modulus > 0) != !linear_.storage.empty() ||
                              (!linear_.storage.empty() && dt != linear_.dt);
@@ -174,7 +175,18 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   } else {
     for (std::size_t i = 0; i < linear_.coupling_k.size(); ++i)
       rhs_[linear_.coupling_unknown[i]] += linear_.coupling_k[i] * next_pressure_[linear_.coupling_cell[i]];
-    linear_.cholmod->solve(rhs_, solution_);
+    if (linear_.cholmod->single_precision()) {
+      solution_.resize(nu);
+      for (int u = 0; u < nu; ++u) solution_[u] = next_pressure_[system.unknown_cell[u]];  // warm start
+      if (!linear_.refinement.solve(system, *linear_.cholmod, rhs_, solution_, settings.refinement_tolerance,
+                                    settings.max_refinement_passes)) {
+        linear_.cholmod->promote_to_double(system);  // G too ill-conditioned for a float factor
+        linear_.cholmod->solve(rhs_, solution_);
+      }
+      gs_iterations_ = linear_.refinement.passes();
+    } else {
+      linear_.cholmod->solve(rhs_, solution_);
+    }
     for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
   }
   step_times_.solve = seconds_since(t0);

@@ -9,18 +9,15 @@
 namespace pfv {
 namespace {
 
-// Dot product with four partial sums (vectorises without -ffast-math).
-inline double dot(const double* a, const double* b, int n) {
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+// Dot product with eight partial sums (vectorises without -ffast-math).
+template <class Real>
+inline Real dot(const Real* a, const Real* b, int n) {
+  Real s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   int i = 0;
-  for (; i + 4 <= n; i += 4) {
-    s0 += a[i] * b[i];
-    s1 += a[i + 1] * b[i + 1];
-    s2 += a[i + 2] * b[i + 2];
-    s3 += a[i + 3] * b[i + 3];
-  }
-  for (; i < n; ++i) s0 += a[i] * b[i];
-  return (s0 + s1) + (s2 + s3);
+  for (; i + 8 <= n; i += 8)
+    for (int k = 0; k < 8; ++k) s[k] += a[i + k] * b[i + k];
+  for (; i < n; ++i) s[0] += a[i] * b[i];
+  return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
 inline int thread_index() {
@@ -120,26 +117,39 @@ void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
     }
   }
   top_fraction_ = total > 0 ? top_entries / total : 1;
-  acc_.assign(groups_.size(), std::vector<double>(f.n, 0.0));
-  work_.assign(groups_.size(), std::vector<double>(max_rows, 0.0));
-  y_.assign(f.n, 0.0);
+  const auto size = [&](auto& ws) {
+    ws.acc.assign(groups_.size(), {});
+    ws.work.assign(groups_.size(), {});
+    for (std::size_t t = 0; t < groups_.size(); ++t) {
+      ws.acc[t].assign(f.n, 0);
+      ws.work[t].assign(max_rows, 0);
+    }
+    ws.y.assign(f.n, 0);
+  };
+  ws64_ = {};
+  ws32_ = {};
+  if (f.values32)
+    size(ws32_);
+  else
+    size(ws64_);
 }
 
-void ParallelSubstitution::forward(int s, double* acc, double* w) {
+template <class Real>
+void ParallelSubstitution::forward(const Real* values, Workspace<Real>& ws, int s, Real* acc, Real* w) {
   const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1;
   const int nsrow = L_.pi[s + 1] - L_.pi[s], nrest = nsrow - nscol;
   const int* r = L_.rows + L_.pi[s] + nscol;
-  const double* Ls = L_.values + L_.px[s];
-  double* y = y_.data();
+  const Real* Ls = values + L_.px[s];
+  Real* y = ws.y.data();
   for (int j = 0; j < nscol; ++j) {  // the dense triangle
-    const double* col = Ls + static_cast<std::ptrdiff_t>(j) * nsrow;
-    const double xj = (y[k1 + j] /= col[j]);
+    const Real* col = Ls + static_cast<std::ptrdiff_t>(j) * nsrow;
+    const Real xj = (y[k1 + j] /= col[j]);
     for (int i = j + 1; i < nscol; ++i) y[k1 + i] -= col[i] * xj;
   }
-  std::fill(w, w + nrest, 0.0);
+  std::fill(w, w + nrest, Real(0));
   for (int j = 0; j < nscol; ++j) {  // the rectangle below it
-    const double* off = Ls + static_cast<std::ptrdiff_t>(j) * nsrow + nscol;
-    const double xj = y[k1 + j];
+    const Real* off = Ls + static_cast<std::ptrdiff_t>(j) * nsrow + nscol;
+    const Real xj = y[k1 + j];
     for (int i = 0; i < nrest; ++i) w[i] += off[i] * xj;
   }
   if (acc) {  // top rows are shared between threads: collect their updates apart
@@ -154,45 +164,63 @@ void ParallelSubstitution::forward(int s, double* acc, double* w) {
   }
 }
 
-void ParallelSubstitution::backward(int s, double* w) {
+template <class Real>
+void ParallelSubstitution::backward(const Real* values, Workspace<Real>& ws, int s, Real* w) {
   const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1;
   const int nsrow = L_.pi[s + 1] - L_.pi[s], nrest = nsrow - nscol;
   const int* r = L_.rows + L_.pi[s] + nscol;
-  const double* Ls = L_.values + L_.px[s];
-  double* y = y_.data();
+  const Real* Ls = values + L_.px[s];
+  Real* y = ws.y.data();
   for (int i = 0; i < nrest; ++i) w[i] = y[r[i]];
   for (int j = nscol - 1; j >= 0; --j) {
-    const double* col = Ls + static_cast<std::ptrdiff_t>(j) * nsrow;
-    const double t = y[k1 + j] - dot(col + nscol, w, nrest) - dot(col + j + 1, y + k1 + j + 1, nscol - j - 1);
+    const Real* col = Ls + static_cast<std::ptrdiff_t>(j) * nsrow;
+    const Real t = y[k1 + j] - dot(col + nscol, w, nrest) - dot(col + j + 1, y + k1 + j + 1, nscol - j - 1);
     y[k1 + j] = t / col[j];
   }
 }
 
-void ParallelSubstitution::solve(const double* b, double* x) {
+void ParallelSubstitution::solve(const double* b, double* x, bool parallel) {
+  if (L_.values32)
+    solve_with(L_.values32, ws32_, b, x, parallel);
+  else
+    solve_with(L_.values, ws64_, b, x, parallel);
+}
+
+template <class Real>
+void ParallelSubstitution::solve_with(const Real* values, Workspace<Real>& ws, const double* b, double* x,
+                                      bool parallel) {
   const int n = L_.n;
-  for (int k = 0; k < n; ++k) y_[k] = b[L_.perm[k]];
+  for (int k = 0; k < n; ++k) ws.y[k] = static_cast<Real>(b[L_.perm[k]]);
   const int groups = static_cast<int>(groups_.size());
-#pragma omp parallel num_threads(groups) if (groups > 1)
-  {
-    const int t = thread_index();
-    double* acc = acc_[t].data();
+  parallel = parallel && groups > 1;
+  const auto forward_group = [&](int t) {
     for (const auto& [a, z] : groups_[t])
-      for (int s = a; s <= z; ++s) forward(s, acc, work_[t].data());
+      for (int s = a; s <= z; ++s) forward(values, ws, s, ws.acc[t].data(), ws.work[t].data());
+  };
+  const auto backward_group = [&](int t) {
+    for (auto g = groups_[t].rbegin(); g != groups_[t].rend(); ++g)
+      for (int s = g->second; s >= g->first; --s) backward(values, ws, s, ws.work[t].data());
+  };
+  if (parallel) {
+#pragma omp parallel num_threads(groups)
+    forward_group(thread_index());
+  } else {
+    for (int t = 0; t < groups; ++t) forward_group(t);
   }
   for (int k : top_rows_)
     for (int t = 0; t < groups; ++t) {
-      y_[k] -= acc_[t][k];
-      acc_[t][k] = 0.0;
+      ws.y[k] -= ws.acc[t][k];
+      ws.acc[t][k] = 0;
     }
-  for (int s : top_) forward(s, nullptr, work_[0].data());
-  for (auto it = top_.rbegin(); it != top_.rend(); ++it) backward(*it, work_[0].data());
-#pragma omp parallel num_threads(groups) if (groups > 1)
-  {
-    const int t = thread_index();
-    for (auto g = groups_[t].rbegin(); g != groups_[t].rend(); ++g)
-      for (int s = g->second; s >= g->first; --s) backward(s, work_[t].data());
+  for (int s : top_) forward(values, ws, s, static_cast<Real*>(nullptr), ws.work[0].data());
+  for (auto it = top_.rbegin(); it != top_.rend(); ++it) backward(values, ws, *it, ws.work[0].data());
+  if (parallel) {
+#pragma omp parallel num_threads(groups)
+    backward_group(thread_index());
+  } else {
+    for (int t = 0; t < groups; ++t) backward_group(t);
   }
-  for (int k = 0; k < n; ++k) x[L_.perm[k]] = y_[k];
+  for (int k = 0; k < n; ++k) x[L_.perm[k]] = ws.y[k];
 }
 
 }  // namespace pfv

@@ -5,7 +5,7 @@
 // thread, balanced by the number of factor entries, and a top solved on one thread: forwards
 // the groups run in parallel (updates to top rows go to per-thread buffers, summed after),
 // then the top; backwards the top first, then the groups in parallel. The solve is bound by
-// reading the factor, so a second core adds memory bandwidth.
+// reading the factor, so a second core adds memory bandwidth, and a float factor halves it.
 #pragma once
 #include <utility>
 #include <vector>
@@ -13,6 +13,8 @@
 namespace pfv {
 
 // A read-only view of CHOLMOD's supernodal LL' factor (see cholmod_factor: super, pi, px, s).
+// The values are either CHOLMOD's doubles or a single-precision copy (exactly one is set):
+// the substitution reads every factor entry once per pass, so floats halve its memory traffic.
 struct SupernodalFactor {
   int n = 0, nsuper = 0;
   const int* super = nullptr;
@@ -21,6 +23,7 @@ struct SupernodalFactor {
   const int* rows = nullptr;
   const int* perm = nullptr;
   const double* values = nullptr;
+  const float* values32 = nullptr;
 };
 
 class ParallelSubstitution {
@@ -28,20 +31,33 @@ class ParallelSubstitution {
   void plan(const SupernodalFactor& factor, int threads);
   int threads() const { return static_cast<int>(groups_.size()); }
   double top_fraction() const { return top_fraction_; }  // share of entries solved serially
-  // x = (L L')^-1 applied to b in the original ordering.
-  void solve(const double* b, double* x);
+  // x = (L L')^-1 applied to b in the original ordering. With parallel = false the groups
+  // run one after the other on the calling thread (same arithmetic, same result).
+  void solve(const double* b, double* x, bool parallel = true);
 
  private:
-  void forward(int s, double* acc, double* w);
-  void backward(int s, double* w);
+  // Per-thread update buffers and the permuted right-hand side, in the factor's precision:
+  // with a float factor the whole substitution runs in float (refinement recovers double
+  // accuracy, and float arithmetic moves twice as many entries per vector instruction).
+  template <class Real>
+  struct Workspace {
+    std::vector<std::vector<Real>> acc, work;
+    std::vector<Real> y;
+  };
+  template <class Real>
+  void forward(const Real* values, Workspace<Real>& ws, int s, Real* acc, Real* w);
+  template <class Real>
+  void backward(const Real* values, Workspace<Real>& ws, int s, Real* w);
+  template <class Real>
+  void solve_with(const Real* values, Workspace<Real>& ws, const double* b, double* x, bool parallel);
 
   SupernodalFactor L_;
   std::vector<std::vector<std::pair<int, int>>> groups_;  // per thread: supernode ranges
   std::vector<int> top_;                                  // top supernodes, increasing
   std::vector<char> top_row_;                             // per row: owned by a top supernode
   std::vector<int> top_rows_;
-  std::vector<std::vector<double>> acc_, work_;
-  std::vector<double> y_;
+  Workspace<double> ws64_;
+  Workspace<float> ws32_;
   double top_fraction_ = 1;
 };
 

@@ -49,6 +49,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
                                  const EngineSettings& settings, double dt) {
   LinearSystem l;
   l.dt = dt;
+  l.mixed_precision = settings.mixed_precision;
   if (settings.fluid_bulk_modulus > 0) {
     l.storage.resize(m.mesh().n_cells());
     for (int c = 0; c < m.mesh().n_cells(); ++c)
@@ -73,7 +74,8 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
 
   t0 = Clock::now();
   if (settings.use_solver == 3 && s.n_unknowns() > 0)
-    l.cholmod->factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering);
+    l.cholmod->factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering,
+                         settings.mixed_precision ? FactorPrecision::kSingle : FactorPrecision::kDouble);
   if (settings.use_solver == 1 && s.n_unknowns() > 0) l.pcg.setup(s);
   l.times.analysis = l.cholmod->analysis_seconds();
   l.times.factorization = seconds_since(t0) - l.times.analysis;

@@ -10,6 +10,7 @@
 #include "engine_settings.hpp"
 #include "force_cache.hpp"
 #include "pcg_solver.hpp"
+#include "refinement.hpp"
 #include "pore_geometry.hpp"
 #include "pressure_system.hpp"
 #include "regular_triangulation.hpp"
@@ -33,6 +34,8 @@ struct LinearSystem {
   std::vector<int> coupling_unknown, coupling_cell;  // Dirichlet neighbours of unknowns
   std::vector<double> coupling_k;
   std::unique_ptr<CholmodSolver> cholmod = std::make_unique<CholmodSolver>();  // useSolver 3
+  Refinement refinement;         // with a single-precision factor
+  bool mixed_precision = false;  // the setting the factor was built for
   PcgSolver pcg;                                                               // useSolver 1
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;
   std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid

@@ -187,6 +187,15 @@ PYBIND11_MODULE(_core, m) {
                       e.settings.ordering = it->second;
                       e.request_bc_update();
                     })
+      .def_property("mixed_precision", [](const FlowEngine& e) { return e.settings.mixed_precision; },
+                    [](FlowEngine& e, bool v) { e.settings.mixed_precision = v; })
+      .def_property("refinement_tolerance", [](const FlowEngine& e) { return e.settings.refinement_tolerance; },
+                    [](FlowEngine& e, double v) {
+                      if (!(v > 0 && v < 1)) throw py::value_error("refinement_tolerance must be in (0, 1)");
+                      e.settings.refinement_tolerance = v;
+                    })
+      .def("single_precision_factor", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().single_precision(); })
+      .def("refinement_contraction", &FlowEngine::refinement_contraction)
       .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholmod().factor_nonzeros(); })
       .def("factor_flops", [](const FlowEngine& e) { return e.cholmod().factor_flops(); })
       .def_property("fluid_bulk_modulus", [](const FlowEngine& e) { return e.settings.fluid_bulk_modulus; },

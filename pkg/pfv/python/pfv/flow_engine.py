@@ -85,6 +85,9 @@ _SUPPORTED = {
     "pZero": "p_zero",
     "multithread": "background_remesh",
     "fluidBulkModulus": "fluid_bulk_modulus",
+    # PFV extensions (PEP 8 names: YADE has no equivalent).
+    "mixed_precision": "mixed_precision",
+    "refinement_tolerance": "refinement_tolerance",
 }
 
 

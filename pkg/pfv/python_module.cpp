@@ -12,6 +12,7 @@
 #endif
 
 #include "flow_engine.hpp"
+#include "yade_force_bridge.hpp"
 
 namespace py = pybind11;
 using namespace pfv;
@@ -96,23 +97,13 @@ PYBIND11_MODULE(_core, m) {
 #endif
   });
 
-  // The per-step bridge to YADE: one O.forces.addF(id, (fx, fy, fz)) per body, called from C++
-  // to spare the interpreter loop (YADE has no bulk force setter).
-  m.def("add_forces", [](py::object add, const py::array_t<long long>& ids, const Array& forces, py::ssize_t first) {
-    const auto id = ids.unchecked<1>();
-    const auto f = forces.unchecked<2>();
-    PyObject* fn = add.ptr();
-    for (py::ssize_t i = 0; i < id.shape(0); ++i) {
-      const py::ssize_t row = first + i;
-      PyObject* args[2] = {PyLong_FromLongLong(id(i)), nullptr};
-      args[1] = Py_BuildValue("(ddd)", f(row, 0), f(row, 1), f(row, 2));
-      PyObject* r = (args[0] && args[1]) ? PyObject_Vectorcall(fn, args, 2, nullptr) : nullptr;
-      Py_XDECREF(args[0]);
-      Py_XDECREF(args[1]);
-      if (!r) throw py::error_already_set();
-      Py_DECREF(r);
-    }
-  });
+  // The per-step bridge to YADE (yade_force_bridge.hpp).
+  py::class_<YadeForceBridge>(m, "YadeForceBridge")
+      .def(py::init<py::object, const py::array_t<long long>&, const py::array_t<long long>&>(),
+           py::arg("vector3_type"), py::arg("ids"), py::arg("rows"))
+      .def("apply", &YadeForceBridge::apply, py::arg("add"), py::arg("forces"))
+      .def_property_readonly("writes_in_place", &YadeForceBridge::writes_in_place)
+      .def("__len__", &YadeForceBridge::size);
 
   // Sphere centres straight from YADE's coordinate lists (yade._utils.coordsAndDisplacements
   // returns one Python list per axis, all bodies): no numpy round trip.

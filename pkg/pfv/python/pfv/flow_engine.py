@@ -20,7 +20,7 @@ import yade
 from yade.wrapper import PyRunner, Sphere, Box
 from yade.minieigenHP import Vector3
 
-from ._core import Engine, add_forces, gather_positions, set_num_threads
+from ._core import Engine, YadeForceBridge, gather_positions, set_num_threads
 from ._yade_api import ATTRIBUTES as _YADE_ATTRIBUTES, METHODS as _YADE_METHODS
 
 __all__ = ["FlowEngine", "TimeStepWarning"]
@@ -65,7 +65,7 @@ _INTERNAL = frozenset({
     "_core", "_key", "_ids", "_rows", "_radii", "_wall_rows", "_wall_half", "_n_bodies",
     "_boundary_use_max_min", "_wall_ids", "_warned", "_vertex_of_id", "_threads",
     "_mass_per_diameter", "_dt_dem", "_masses", "_dt_collective", "_collective_viscosity",
-    "time_step_safety", "strict_time_step",
+    "time_step_safety", "strict_time_step", "_force_bridge",
 })
 # YADE attributes PFV implements through a core attribute of another name (the others are
 # properties of FlowEngine below).
@@ -104,6 +104,7 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_wall_ids", list(range(6)))
         object.__setattr__(self, "_warned", set())
         object.__setattr__(self, "_ids", None)
+        object.__setattr__(self, "_force_bridge", None)
         object.__setattr__(self, "_threads", None)  # None: follow YADE's -j
         object.__setattr__(self, "_mass_per_diameter", float("inf"))
         object.__setattr__(self, "_dt_dem", float("inf"))
@@ -260,6 +261,13 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_vertex_of_id", vertex_of_id)
         object.__setattr__(self, "_mass_per_diameter", mass_per_diameter)
         object.__setattr__(self, "_masses", np.array(masses, dtype=float))
+        # Spheres get force rows 0..n-1, the walls present rows n + w.
+        bridge_ids = ids + [bid for w, bid in enumerate(self._wall_ids) if wall_rows[w] >= 0]
+        bridge_rows = list(range(len(ids))) + [len(ids) + w for w in range(6) if wall_rows[w] >= 0]
+        key = (bridge_ids, bridge_rows)
+        if self._force_bridge is None or self._force_bridge[0] != key:  # its Vector3s are made once
+            bridge = YadeForceBridge(Vector3, np.array(bridge_ids, dtype=np.int64), np.array(bridge_rows, dtype=np.int64))
+            object.__setattr__(self, "_force_bridge", (key, bridge))
         dem = yade.utils.PWaveTimeStep() if ids else float("inf")
         object.__setattr__(self, "_dt_dem", dem if dem > 0 else float("inf"))
 
@@ -301,13 +309,7 @@ class FlowEngine(PyRunner):
                 warnings.warn(f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
                               f"regular triangulation and get no fluid force (ids {self._ids[hidden][:10].tolist()}...)",
                               stacklevel=2)
-        forces = core.forces()
-        add = O.forces.addF
-        add_forces(add, self._ids, forces, 0)
-        n = len(self._ids)
-        for w, bid in enumerate(self._wall_ids):
-            if self._wall_rows[w] >= 0:
-                add(bid, tuple(forces[n + w]))
+        self._force_bridge[1].apply(O.forces.addF, core.forces())
 
     @property
     def viscous_time_step(self):

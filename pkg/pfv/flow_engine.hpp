@@ -49,7 +49,7 @@ class FlowEngine {
 
   // Stability limit of the explicit coupling from the fluid alone: 2 / lambda_max of
   // M^-1 V, where V maps sphere velocities to fluid forces through the current mesh
-  // (dV/dt -> solve -> forces). Power iteration from the last step's positions; masses <= 0
+  // (dV/dt -> solve -> forces, plus the viscous shear term when on). Power iteration from the last step's positions; masses <= 0
   // mark spheres that do not move. Collective modes (groups of spheres squeezing shared
   // pores) make this smaller than the thesis' single-particle dt_MV. Needs a mesh.
   double viscous_stability_limit(const std::vector<double>& mass, int iterations) const;

@@ -31,12 +31,16 @@ struct EngineSettings {
   // Remesh on a second thread from a snapshot while steps go on with the old mesh (YADE's
   // `multithread`): the new mesh arrives a few steps late.
   bool background_remesh = false;
+  // Viscous shear between neighbouring spheres (YADE's viscousShear; viscous_shear.hpp). Off:
+  // no pair geometry is built or stored and the step does no extra work.
+  bool viscous_shear = false;
 };
 
 // Seconds spent in each stage: the last remesh, and the last step without remesh.
 struct StageTimes {
   double triangulation = 0, geometry = 0, conductance = 0, assembly = 0, analysis = 0, factorization = 0;
   double force_cache = 0, volumes = 0, solve = 0, forces = 0;
+  double shear_geometry = 0, shear_forces = 0;  // zero while viscous_shear is off
 };
 
 }  // namespace pfv

@@ -26,7 +26,8 @@ FlowEngine::~FlowEngine() {
 bool FlowEngine::remesh_due() const {
   return remesh_requested_ || !has_mesh() ||
          (settings.mesh_update_interval > 0 && steps_since_remesh_ >= settings.mesh_update_interval) ||
-         (settings.def_tolerance > 0 && strain_ >= settings.def_tolerance);
+         (settings.def_tolerance > 0 && strain_ >= settings.def_tolerance) ||
+         (settings.viscous_shear && !mesh_->shear);  // switched on: the pairs come with a remesh
 }
 
 void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, int bc_version) {
@@ -68,6 +69,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   if (settings.use_solver != 0 && settings.use_solver != 1 && settings.use_solver != 3)
     bad_input("useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG) or 3 (CHOLMOD)");
   validate_snapshot(centres, radii, walls);
+  if (settings.viscous_shear && has_mesh() && !mesh_->shear) remesh_requested_ = true;  // in the foreground
 
   const bool same_spheres = has_mesh() && centres.size() == static_cast<std::size_t>(mesh().n_spheres);
   if (pending_ && (!same_spheres || remesh_requested_)) {
@@ -195,6 +197,20 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   mesh_->cache.apply(next_pressure_, next_force_);
   step_times_.forces = seconds_since(t0);
 
+  if (!settings.viscous_shear && mesh_->shear) mesh_->shear.reset();  // switched off (or adopted from before)
+  if (mesh_->shear) {
+    t0 = Clock::now();
+    if (has_prev_ && centres_prev_.size() == centres.size())
+      mesh_->shear->add_forces(centres, centres_prev_, dt, settings.conductance.viscosity, next_force_, next_shear_);
+    else
+      next_shear_.assign(next_force_.size(), Vec3::Zero());  // no velocities yet
+    step_times_.shear_forces = seconds_since(t0);
+  } else if (!shear_force_.empty() || !next_shear_.empty()) {
+    std::vector<Vec3>().swap(shear_force_);
+    std::vector<Vec3>().swap(next_shear_);
+    step_times_.shear_forces = 0;
+  }
+
   // Never hand NaN or infinite forces back to the DEM.
   const auto bad_p = std::find_if(next_pressure_.begin(), next_pressure_.end(), [](double x) { return !std::isfinite(x); });
   if (bad_p != next_pressure_.end())
@@ -206,6 +222,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   std::swap(volume_, next_volume_);
   std::swap(pressure_, next_pressure_);
   std::swap(force_, next_force_);
+  std::swap(shear_force_, next_shear_);
   strain_ += max_change;
   ++steps_since_remesh_;
   centres_prev_ = centres;
@@ -235,7 +252,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
   for (int a = 0; a < 3; ++a) h = std::max(h, walls_prev_.extent(a));
   h *= 1e-7;
   std::vector<double> rhs(nu), x, p_cells(nc, 0.0), gs_p;
-  std::vector<Vec3> force;
+  std::vector<Vec3> force, shear;
   double lambda = 0;
   for (int it = 0; it < iterations; ++it) {
     norm = 0;
@@ -263,6 +280,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
     }
     for (int u = 0; u < nu; ++u) p_cells[system.unknown_cell[u]] = x[u];
     mesh_->cache.apply(p_cells, force);
+    if (mesh_->shear) mesh_->shear->add_velocity_forces(v, settings.conductance.viscosity, force, shear);
     double a_norm = 0;
     for (int k = 0; k < n; ++k) {
       v[k] = mass[k] > 0 ? Vec3(force[k] / mass[k]) : Vec3::Zero();

@@ -49,13 +49,18 @@ class FlowEngine {
 
   // Stability limit of the explicit coupling from the fluid alone: 2 / lambda_max of
   // M^-1 V, where V maps sphere velocities to fluid forces through the current mesh
-  // (dV/dt -> solve -> forces). Power iteration from the last step's positions; masses <= 0
+  // (dV/dt -> solve -> forces, plus the viscous shear term when on). Power iteration from the last step's positions; masses <= 0
   // mark spheres that do not move. Collective modes (groups of spheres squeezing shared
   // pores) make this smaller than the thesis' single-particle dt_MV. Needs a mesh.
   double viscous_stability_limit(const std::vector<double>& mass, int iterations) const;
 
   // Results of the last step.
   const std::vector<Vec3>& forces() const { return force_; }  // spheres, then six walls
+  // The viscous shear part of forces() (empty while viscous_shear is off; zero on a step
+  // without previous positions, whose velocities are unknown).
+  const std::vector<Vec3>& shear_forces() const { return shear_force_; }
+  // The pairs of the current mesh, or nullptr while viscous_shear is off.
+  const ViscousShear* viscous_shear() const { return mesh_ && mesh_->shear ? &*mesh_->shear : nullptr; }
   const std::vector<double>& pressure() const { return pressure_; }
   const Mesh& mesh() const { return mesh_->mesh(); }
   const CellGeometry& cells() const { return mesh_->cells; }
@@ -98,6 +103,7 @@ class FlowEngine {
   std::vector<Vec3> force_;
   std::vector<double> next_volume_, next_pressure_;  // scratch of the step being computed
   std::vector<Vec3> next_force_;
+  std::vector<Vec3> shear_force_, next_shear_;  // only with viscous_shear
   std::vector<Vec3> centres_prev_;
   BoxWalls walls_prev_;
   bool has_prev_ = false;

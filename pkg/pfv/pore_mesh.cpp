@@ -42,6 +42,12 @@ PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<dou
   t0 = Clock::now();
   m.cache.build(mesh, m.facets, packing);
   m.times.force_cache = seconds_since(t0);
+
+  if (settings.viscous_shear) {
+    t0 = Clock::now();
+    m.shear = build_viscous_shear(mesh, m.cells, m.facets, packing, !settings.slip_boundary);
+    m.times.shear_geometry = seconds_since(t0);
+  }
   return m;
 }
 

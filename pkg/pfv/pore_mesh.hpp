@@ -1,9 +1,10 @@
 // The products of a remesh, built from one snapshot and independent of the engine's state:
-// the pore mesh (triangulation, geometry, conductances, force cache) and the linear system
+// the pore mesh (triangulation, geometry, conductances, force cache, viscous shear pairs) and the linear system
 // over it (assembly and factorisation for given boundary conditions). Building them touches
 // nothing shared, so a remesh can run on another thread.
 #pragma once
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "boundary_conditions.hpp"
@@ -14,6 +15,7 @@
 #include "pore_geometry.hpp"
 #include "pressure_system.hpp"
 #include "regular_triangulation.hpp"
+#include "viscous_shear.hpp"
 
 namespace pfv {
 
@@ -23,8 +25,9 @@ struct PoreMesh {
   FacetGeometry facets;
   std::vector<double> k;
   ForceCache cache;
+  std::optional<ViscousShear> shear;  // only with settings.viscous_shear
   double mean_cell_volume = 0;
-  StageTimes times;  // triangulation, geometry, conductance, force_cache
+  StageTimes times;  // triangulation, geometry, conductance, force_cache, shear_geometry
 
   const Mesh& mesh() const { return tri.mesh(); }
 };

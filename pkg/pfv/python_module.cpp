@@ -63,6 +63,8 @@ py::dict times_dict(const StageTimes& t) {
   d["volumes"] = t.volumes;
   d["solve"] = t.solve;
   d["forces"] = t.forces;
+  d["shear_geometry"] = t.shear_geometry;
+  d["shear_forces"] = t.shear_forces;
   return d;
 }
 
@@ -196,6 +198,9 @@ PYBIND11_MODULE(_core, m) {
                     })
       .def_property("background_remesh", [](const FlowEngine& e) { return e.settings.background_remesh; },
                     [](FlowEngine& e, bool v) { e.settings.background_remesh = v; })
+      .def_property("viscous_shear", [](const FlowEngine& e) { return e.settings.viscous_shear; },
+                    [](FlowEngine& e, bool v) { e.settings.viscous_shear = v; },
+                    "Viscous shear between neighbouring spheres (YADE's viscousShear); switching it on remeshes at the next step.")
       .def("remesh_pending", &FlowEngine::remesh_pending)
       .def("wait_for_remesh", &FlowEngine::wait_for_remesh, py::call_guard<py::gil_scoped_release>())
       .def_property("mesh_update_interval", [](const FlowEngine& e) { return e.settings.mesh_update_interval; },
@@ -249,6 +254,20 @@ PYBIND11_MODULE(_core, m) {
            }, py::arg("masses"), py::arg("iterations") = 40)
       .def("forces", [](const FlowEngine& e) { return points_to_array(e.forces()); },
            "Fluid force on every sphere (input order), then on the six walls.")
+      .def("shear_forces", [](const FlowEngine& e) { return points_to_array(e.shear_forces()); },
+           "The viscous shear part of forces() (empty while viscous_shear is off).")
+      .def("shear_pairs", [](const FlowEngine& e) {
+             const ViscousShear* s = meshed(e).viscous_shear();
+             if (!s) throw py::value_error("viscous_shear is off: the mesh has no shear pairs");
+             py::dict d;
+             d["a"] = vector_to_array(s->a);
+             d["b"] = vector_to_array(s->b);
+             d["direction"] = points_to_array(s->direction);
+             d["area"] = vector_to_array(s->area);
+             d["hydraulic_radius"] = vector_to_array(s->hydraulic_radius);
+             d["open_rings"] = s->open_rings;
+             return d;
+           }, "Pairs of the shear term: vertices a, b (b >= n spheres: wall), unit a->b, S_vor, R_h.")
       .def("pressure", [](const FlowEngine& e) { return vector_to_array(e.pressure()); })
       // Queries.
       .def("n_cells", [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().n_cells() : 0; })

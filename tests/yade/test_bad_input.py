@@ -46,9 +46,9 @@ def fresh(**kw):
 flow = fresh()
 expect_error("unknown attribute", AttributeError, "viscosityy", lambda: setattr(flow, "viscosityy", 1.0))
 expect_error("unknown constructor keyword", AttributeError, "pressureeForce", lambda: FlowEngine(pressureeForce=True))
-expect_error("YADE attribute not supported", NotImplementedError, "viscousShear",
-             lambda: setattr(flow, "viscousShear", True))
-flow.viscousShear = False  # YADE's default is accepted
+expect_error("YADE attribute not supported", NotImplementedError, "normalLubrication",
+             lambda: setattr(flow, "normalLubrication", True))
+flow.normalLubrication = False  # YADE's default is accepted
 expect_error("YADE method not supported", NotImplementedError, "saveVtk", lambda: flow.saveVtk("/tmp/x"))
 expect_error("non-positive viscosity", ValueError, "viscosity", lambda: setattr(flow, "viscosity", -1.0))
 expect_error("NaN viscosity", ValueError, "viscosity", lambda: setattr(flow, "viscosity", float("nan")))

@@ -85,6 +85,7 @@ _SUPPORTED = {
     "pZero": "p_zero",
     "multithread": "background_remesh",
     "fluidBulkModulus": "fluid_bulk_modulus",
+    "viscousShear": "viscous_shear",
     # PFV extensions (PEP 8 names: YADE has no equivalent).
     "mixed_precision": "mixed_precision",
     "refinement_tolerance": "refinement_tolerance",
@@ -327,9 +328,11 @@ class FlowEngine(PyRunner):
         Computed by power iteration on the first mesh, and again when the viscosity changes."""
         if not self._core.has_mesh():
             return float("inf")
-        if self._dt_collective is None or self._collective_viscosity != self._core.viscosity:
+        # The shear term adds damping to the operator, so switching it recomputes the limit too.
+        key = (self._core.viscosity, self._core.viscous_shear and self._core.shear_forces().size > 0)
+        if self._dt_collective is None or self._collective_viscosity != key:
             object.__setattr__(self, "_dt_collective", self._core.viscous_stability_limit(self._masses, 40))
-            object.__setattr__(self, "_collective_viscosity", self._core.viscosity)
+            object.__setattr__(self, "_collective_viscosity", key)
         return self._dt_collective
 
     @property
@@ -421,6 +424,16 @@ class FlowEngine(PyRunner):
         if v is None:
             raise ValueError(f"body {idSph} is not coupled with the fluid (not a sphere nor a wall)")
         return Vector3(*self._core.forces()[v])
+
+    def shearLubForce(self, idSph):
+        """The viscous shear part of fluidForce(idSph) (viscousShear; zero while it is off).
+        YADE's name: its shearLubForce reports the viscousShear force as well."""
+        self._require_mesh()
+        v = self._vertex_of_id.get(int(idSph))
+        if v is None:
+            raise ValueError(f"body {idSph} is not coupled with the fluid (not a sphere nor a wall)")
+        shear = self._core.shear_forces()
+        return Vector3(*shear[v]) if len(shear) else Vector3(0, 0, 0)
 
     def nCells(self):
         return self._core.n_cells()

@@ -53,6 +53,32 @@ double CholmodSolver::factor_nonzeros() const {
   return factor_ ? common_->c.lnz : 0.0;
 }
 
+const int* CholmodSolver::permutation() const {
+  return factor_ ? static_cast<const int*>(static_cast<const cholmod_factor*>(factor_)->Perm) : nullptr;
+}
+
+SupernodalChains CholmodSolver::chains() const {
+  SupernodalChains t;
+  const auto* f = static_cast<const cholmod_factor*>(factor_);
+  if (!f || !f->is_super) return t;
+  const int n = static_cast<int>(f->n);
+  t.chain_end.resize(n);
+  t.parent.assign(n, -1);
+  const auto* super = static_cast<const int*>(f->super);
+  const auto* pi = static_cast<const int*>(f->pi);
+  const auto* rows = static_cast<const int*>(f->s);
+  for (std::size_t s = 0; s < f->nsuper; ++s) {
+    const int k1 = super[s], k2 = super[s + 1], nscol = k2 - k1;
+    for (int j = k1; j < k2; ++j) t.chain_end[j] = k2 - 1;
+    if (pi[s + 1] - pi[s] > nscol) t.parent[k2 - 1] = rows[pi[s] + nscol];  // first row below the block
+  }
+  return t;
+}
+
+double CholmodSolver::fill() const {
+  return factor_ ? common_->c.lnz / static_cast<double>(static_cast<const cholmod_factor*>(factor_)->n) : 0.0;
+}
+
 double CholmodSolver::factor_flops() const {
   return factor_ ? common_->c.fl : 0.0;
 }
@@ -78,27 +104,41 @@ cholmod_sparse view_of(const PressureSystem& s) {
 
 }  // namespace
 
-void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, FactorPrecision precision) {
+void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, FactorPrecision precision,
+                             const GivenOrdering& given) {
   release();
   cholmod_common* c = &common_->c;
   const int n = s.n_unknowns();
   if (n == 0) return;
   c->postorder = 1;
-  if (ordering == Ordering::kAuto) {
-    c->nmethods = 0;
-  } else {
-    c->nmethods = 1;
-    c->method[0].ordering = ordering == Ordering::kAmd     ? CHOLMOD_AMD
-                            : ordering == Ordering::kMetis ? CHOLMOD_METIS
-                                                           : CHOLMOD_NESDIS;
-  }
   cholmod_sparse a = view_of(s);
   const auto t0 = std::chrono::steady_clock::now();
-  cholmod_factor* f = cholmod_analyze(&a, c);
+  cholmod_factor* f = nullptr;
+  ordering_given_ = false;
+  if (static_cast<int>(given.perm.size()) == n) {
+    c->nmethods = 1;
+    c->method[0].ordering = CHOLMOD_GIVEN;
+    f = cholmod_analyze_p(&a, const_cast<int*>(given.perm.data()), nullptr, 0, c);
+    ordering_given_ = f && c->lnz <= given.max_fill * n;
+    if (f && !ordering_given_) cholmod_free_factor(&f, c);
+    metis_used_ = given.from_metis;
+  }
+  if (!ordering_given_) {
+    if (ordering == Ordering::kAuto) {
+      c->nmethods = 0;
+    } else {
+      c->nmethods = 1;
+      c->method[0].ordering = ordering == Ordering::kAmd     ? CHOLMOD_AMD
+                              : ordering == Ordering::kMetis ? CHOLMOD_METIS
+                                                             : CHOLMOD_NESDIS;
+    }
+    f = cholmod_analyze(&a, c);
+  }
   analysis_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!f) throw std::runtime_error("CHOLMOD analysis failed (status " + std::to_string(c->status) + ")");
   factor_ = f;
-  metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
+  if (!ordering_given_)
+    metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
   numeric_factorization(s);
   rhs_ = cholmod_zeros(n, 1, CHOLMOD_REAL, c);
 

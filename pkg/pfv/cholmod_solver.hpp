@@ -10,6 +10,14 @@ namespace pfv {
 
 struct PressureSystem;
 
+// The elimination tree of a supernodal factor, in elimination positions: the columns of a
+// supernode form a chain ending at chain_end; parent[chain_end] is the first column below the
+// supernode's diagonal block (-1 at a root). Postordered, so every subtree is a contiguous
+// range of positions ending at its root.
+struct SupernodalChains {
+  std::vector<int> chain_end, parent;
+};
+
 // Fill-reducing ordering. kAuto is CHOLMOD's default (AMD, then METIS if AMD fills badly).
 enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
 
@@ -17,6 +25,14 @@ enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
 // freed): half the memory and half the memory traffic of a substitution, whose result is then
 // only an approximate inverse, to be used inside iterative refinement (refinement.hpp).
 enum class FactorPrecision { kDouble, kSingle };
+
+// An elimination order of the unknowns to try before computing one (ordering_reuse.hpp): kept
+// if its factor has at most max_fill entries per unknown.
+struct GivenOrdering {
+  std::vector<int> perm;  // perm[k] = unknown eliminated k-th; empty: none
+  double max_fill = 0;
+  bool from_metis = false;  // where the order it descends from came from (for metis_used)
+};
 
 class CholmodSolver {
  public:
@@ -27,8 +43,9 @@ class CholmodSolver {
 
   // Throws std::domain_error if G is not positive definite. A single-precision request falls
   // back to double when an entry of the factor is out of float's normal range.
+  // 'ordering' is computed unless 'given' is accepted.
   void factorize(const PressureSystem& system, Ordering ordering,
-                 FactorPrecision precision = FactorPrecision::kDouble);
+                 FactorPrecision precision = FactorPrecision::kDouble, const GivenOrdering& given = {});
   // Refactorises in double on the same ordering (no new analysis): for when refinement with
   // the rounded factor does not converge (G too ill-conditioned for float).
   void promote_to_double(const PressureSystem& system);
@@ -41,6 +58,10 @@ class CholmodSolver {
   bool single_precision() const { return !values32_.empty(); }
   double parallel_top_fraction() const { return parallel_.top_fraction(); }
   bool metis_used() const { return metis_used_; }
+  bool ordering_given() const { return ordering_given_; }  // the given order was kept
+  const int* permutation() const;  // unknown eliminated k-th, after CHOLMOD's postorder
+  double fill() const;             // factor entries per unknown
+  SupernodalChains chains() const;
   bool ready() const { return factor_ != nullptr; }
   double factor_nonzeros() const;
   double factor_flops() const;
@@ -60,6 +81,7 @@ class CholmodSolver {
   std::vector<float> values32_;  // the factor's values in single precision, or empty
   ParallelSubstitution parallel_;
   bool metis_used_ = false;
+  bool ordering_given_ = false;
   double analysis_seconds_ = 0;
 };
 

@@ -14,6 +14,10 @@ struct EngineSettings {
   int max_gs_iterations = 200000;
   bool force_metis = false;  // YADE's forceMetis: METIS ordering whatever 'ordering' says
   Ordering ordering = Ordering::kAuto;
+  // Carry the elimination order over to the next remesh (ordering_reuse.hpp) while its factor
+  // has at most max_fill_growth times the entries per unknown of the last fresh ordering.
+  bool reuse_ordering = true;
+  double max_fill_growth = 1.1;
   // useSolver 3 only: keep the Cholesky factor in single precision and refine each solve in
   // double from the previous pressures (refinement.hpp) until the estimated error is below
   // refinement_tolerance * max|p|. Falls back to the double factor if G is too

@@ -93,9 +93,10 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     if (settings.background_remesh && same_spheres && !remesh_requested_) {
       // Snapshot now, build on another thread, carry on with the current mesh meanwhile.
       pending_ = Pending{std::async(std::launch::async,
-                                    [c = centres, r = radii, w = walls, s = settings, b = bc, dt]() {
+                                    [c = centres, r = radii, w = walls, s = settings, b = bc, dt,
+                                     o = linear_.ordering]() {
                                       PoreMesh m = build_pore_mesh(c, r, w, s);
-                                      LinearSystem l = build_linear_system(m, b, s, dt);
+                                      LinearSystem l = build_linear_system(m, b, s, dt, o.get());
                                       return Remesh(std::move(m), std::move(l));
                                     }),
                          bc_version_};
@@ -107,9 +108,10 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
       // two). Should the new system fail, the old mesh is kept without a factor and the next
       // step starts the remesh over; the last results stay readable meanwhile.
       remesh_requested_ = true;
+      const auto ordering = linear_.ordering;  // survives the release of the old factor
       linear_.cholmod = std::make_unique<CholmodSolver>();
       linear_.pcg = PcgSolver{};
-      LinearSystem l = build_linear_system(m, bc, settings, dt);
+      LinearSystem l = build_linear_system(m, bc, settings, dt, ordering.get());
       adopt(std::move(m), std::move(l), bc_version_);
       strain_ = 0;
       steps_since_remesh_ = 0;
@@ -125,7 +127,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   if (linear_bc_version_ != bc_version_ || solver_missing || storage_stale) {
     // New boundary conditions, a solver chosen after the last remesh, or a new dt or bulk
     // modulus with a compressible fluid.
-    linear_ = build_linear_system(*mesh_, bc, settings, dt);
+    linear_ = build_linear_system(*mesh_, bc, settings, dt, linear_.ordering.get());
     linear_bc_version_ = bc_version_;
   }
 

@@ -52,7 +52,7 @@ PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<dou
 }
 
 LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc,
-                                 const EngineSettings& settings, double dt) {
+                                 const EngineSettings& settings, double dt, const CellOrdering* previous) {
   LinearSystem l;
   l.dt = dt;
   l.mixed_precision = settings.mixed_precision;
@@ -79,9 +79,21 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   l.times.assembly = seconds_since(t0);
 
   t0 = Clock::now();
-  if (settings.use_solver == 3 && s.n_unknowns() > 0)
-    l.cholmod->factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering,
-                         settings.mixed_precision ? FactorPrecision::kSingle : FactorPrecision::kDouble);
+  if (settings.use_solver == 3 && s.n_unknowns() > 0) {
+    GivenOrdering given;
+    if (previous && settings.reuse_ordering) {
+      given.perm = previous->carry_over(m.mesh(), s);
+      given.max_fill = settings.max_fill_growth * previous->fresh_fill();
+      given.from_metis = previous->from_metis();
+    }
+    CholmodSolver& f = *l.cholmod;
+    f.factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering,
+                settings.mixed_precision ? FactorPrecision::kSingle : FactorPrecision::kDouble, given);
+    if (f.ready() && f.permutation())
+      l.ordering = std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
+                                                        f.ordering_given() ? previous->fresh_fill() : f.fill(),
+                                                        f.metis_used());
+  }
   if (settings.use_solver == 1 && s.n_unknowns() > 0) l.pcg.setup(s);
   l.times.analysis = l.cholmod->analysis_seconds();
   l.times.factorization = seconds_since(t0) - l.times.analysis;

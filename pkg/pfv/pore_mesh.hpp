@@ -10,6 +10,7 @@
 #include "boundary_conditions.hpp"
 #include "engine_settings.hpp"
 #include "force_cache.hpp"
+#include "ordering_reuse.hpp"
 #include "pcg_solver.hpp"
 #include "refinement.hpp"
 #include "pore_geometry.hpp"
@@ -39,6 +40,7 @@ struct LinearSystem {
   std::unique_ptr<CholmodSolver> cholmod = std::make_unique<CholmodSolver>();  // useSolver 3
   Refinement refinement;         // with a single-precision factor
   bool mixed_precision = false;  // the setting the factor was built for
+  std::shared_ptr<const CellOrdering> ordering;  // of the factor, for the next remesh
   PcgSolver pcg;                                                               // useSolver 1
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;
   std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid
@@ -50,8 +52,10 @@ struct LinearSystem {
 PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
                          const BoxWalls& walls, const EngineSettings& settings);
 
-// Throws std::domain_error if the system is singular.
+// Throws std::domain_error if the system is singular. previous: the ordering of the last
+// factorisation, tried first when settings.reuse_ordering (null: compute one).
 LinearSystem build_linear_system(const PoreMesh& mesh, const BoundaryConditions& bc,
-                                 const EngineSettings& settings, double dt);
+                                 const EngineSettings& settings, double dt,
+                                 const CellOrdering* previous = nullptr);
 
 }  // namespace pfv

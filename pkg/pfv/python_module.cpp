@@ -187,6 +187,10 @@ PYBIND11_MODULE(_core, m) {
                       if (!(v > 0 && v < 1)) throw py::value_error("refinement_tolerance must be in (0, 1)");
                       e.settings.refinement_tolerance = v;
                     })
+      .def_property("reuse_ordering", [](const FlowEngine& e) { return e.settings.reuse_ordering; },
+                    [](FlowEngine& e, bool v) { e.settings.reuse_ordering = v; })
+      .def("ordering_reused", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().ordering_given(); })
+      .def("factor_fill", [](const FlowEngine& e) { return e.has_mesh() ? e.cholmod().fill() : 0.0; })
       .def("single_precision_factor", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().single_precision(); })
       .def("refinement_contraction", &FlowEngine::refinement_contraction)
       .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholmod().factor_nonzeros(); })

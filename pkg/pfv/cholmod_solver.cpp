@@ -45,7 +45,7 @@ void CholmodSolver::release() {
       *d = nullptr;
     }
   factor_ = nullptr;
-  std::vector<float>().swap(values32_);
+  values32_ = nullptr;
   parallel_ = ParallelSubstitution{};  // it points into the factor just freed
 }
 
@@ -143,21 +143,25 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
   rhs_ = cholmod_zeros(n, 1, CHOLMOD_REAL, c);
 
   if (precision == FactorPrecision::kSingle && f->is_super && f->is_ll) {
-    const auto* x = static_cast<const double*>(f->x);
+    // Round in place, into the first half of CHOLMOD's own array: float i overwrites bytes of
+    // double i/2, which has been read already. No allocation and no fresh pages to fault in
+    // (those cost more than the rounding: 30 ms for the 8e6 entries at 10 000 spheres). The
+    // bytes are copied with memcpy, which is how C++ lets one type's storage hold another's.
+    auto* bytes = static_cast<unsigned char*>(f->x);
     const std::size_t count = static_cast<const int*>(f->px)[f->nsuper];
-    values32_.resize(count);
     bool representable = true;
     for (std::size_t i = 0; i < count; ++i) {
-      const float v = static_cast<float>(x[i]);
-      representable = representable && std::isfinite(v) && (x[i] == 0 || std::abs(v) >= FLT_MIN);
-      values32_[i] = v;
+      double d;
+      std::memcpy(&d, bytes + 8 * i, sizeof d);
+      const float v = static_cast<float>(d);
+      // Overflow, NaN, or a non-zero that float cannot hold normally (subnormal or zero).
+      representable &= std::isfinite(v) & ((d == 0) | (std::abs(v) >= FLT_MIN));
+      std::memcpy(bytes + 4 * i, &v, sizeof v);
     }
     if (representable) {
-      // Keep the symbolic supernodal structure (super, pi, px, s, Perm), free the doubles.
-      cholmod_change_factor(CHOLMOD_PATTERN, true, true, true, true, f, c);
-      if (f->x != nullptr || !f->is_super) throw std::logic_error("CHOLMOD kept the numeric factor");
+      values32_ = reinterpret_cast<const float*>(bytes);
     } else {
-      std::vector<float>().swap(values32_);
+      numeric_factorization(s);  // the doubles were overwritten: factorise again, stay double
     }
   }
   plan_substitution();
@@ -183,8 +187,8 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
 
 void CholmodSolver::promote_to_double(const PressureSystem& s) {
   if (!factor_ || !single_precision()) return;
-  std::vector<float>().swap(values32_);
-  numeric_factorization(s);  // on the symbolic factor kept from the analysis
+  values32_ = nullptr;
+  numeric_factorization(s);  // overwrites the rounded values in place  // on the symbolic factor kept from the analysis
   plan_substitution();
 }
 
@@ -200,7 +204,7 @@ void CholmodSolver::plan_substitution() {
   view.rows = static_cast<const int*>(f->s);
   view.perm = static_cast<const int*>(f->Perm);
   if (single_precision())
-    view.values32 = values32_.data();
+    view.values32 = values32_;
   else
     view.values = static_cast<const double*>(f->x);
   parallel_.plan(view, 2);

@@ -21,9 +21,9 @@ struct SupernodalChains {
 // Fill-reducing ordering. kAuto is CHOLMOD's default (AMD, then METIS if AMD fills badly).
 enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
 
-// kSingle keeps the factor, computed in double, rounded to float (CHOLMOD's double values are
-// freed): half the memory and half the memory traffic of a substitution, whose result is then
-// only an approximate inverse, to be used inside iterative refinement (refinement.hpp).
+// kSingle keeps the factor, computed in double, rounded to float (in CHOLMOD's array): half
+// the memory traffic of a substitution, whose result is then only an approximate inverse, to
+// be used inside iterative refinement (refinement.hpp).
 enum class FactorPrecision { kDouble, kSingle };
 
 // An elimination order of the unknowns to try before computing one (ordering_reuse.hpp): kept
@@ -55,7 +55,7 @@ class CholmodSolver {
   // and the same subtree plan, run serially, in single precision.
   void solve(const std::vector<double>& rhs, std::vector<double>& x);
   void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
-  bool single_precision() const { return !values32_.empty(); }
+  bool single_precision() const { return values32_ != nullptr; }
   double parallel_top_fraction() const { return parallel_.top_fraction(); }
   bool metis_used() const { return metis_used_; }
   bool ordering_given() const { return ordering_given_; }  // the given order was kept
@@ -78,7 +78,7 @@ class CholmodSolver {
   void* x_ = nullptr;
   void* work_y_ = nullptr;
   void* work_e_ = nullptr;
-  std::vector<float> values32_;  // the factor's values in single precision, or empty
+  const float* values32_ = nullptr;  // the factor's values rounded, in CHOLMOD's array; or null
   ParallelSubstitution parallel_;
   bool metis_used_ = false;
   bool ordering_given_ = false;

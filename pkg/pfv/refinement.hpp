@@ -31,7 +31,7 @@ class Refinement {
   int passes() const { return passes_; }
   double contraction() const { return rho_; }  // -1 until measured
 
-  static constexpr int kPowerIterations = 6;
+  static constexpr int kPowerIterations = 4;
   static constexpr double kSafety = 4;
 
  private:

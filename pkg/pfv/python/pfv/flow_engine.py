@@ -20,7 +20,7 @@ import yade
 from yade.wrapper import PyRunner, Sphere, Box
 from yade.minieigenHP import Vector3
 
-from ._core import Engine, YadeForceBridge, gather_positions, set_num_threads
+from ._core import Engine, YadeForceBridge, gather_axis, set_num_threads
 from ._yade_api import ATTRIBUTES as _YADE_ATTRIBUTES, METHODS as _YADE_METHODS
 
 __all__ = ["FlowEngine", "TimeStepWarning"]
@@ -272,15 +272,22 @@ class FlowEngine(PyRunner):
         dem = yade.utils.PWaveTimeStep() if ids else float("inf")
         object.__setattr__(self, "_dt_dem", dem if dem > 0 else float("inf"))
 
-    def _walls(self, coords, pos):
+    def _read_positions(self):
+        """Sphere centres (n, 3) and the six boundary coordinates, one YADE list per axis."""
+        pos = np.empty((len(self._rows), 3))
         walls = [0.0] * 6
+        for axis in range(3):
+            coords = _coordinates(axis)[0]
+            gather_axis(coords, self._rows, pos, axis)
+            for w in (2 * axis, 2 * axis + 1):
+                if not self._boundary_use_max_min[w]:
+                    walls[w] = coords[self._wall_rows[w]] + self._wall_half[w]
+            del coords  # before the next axis' list is made: YADE then reuses its memory
         for w in range(6):
-            axis = w // 2
             if self._boundary_use_max_min[w]:
+                axis = w // 2
                 walls[w] = float((pos[:, axis] + self._radii).max() if w % 2 else (pos[:, axis] - self._radii).min())
-            else:
-                walls[w] = coords[axis][self._wall_rows[w]] + self._wall_half[w]
-        return walls
+        return pos, walls
 
     def _step(self):
         O = yade.O
@@ -293,11 +300,10 @@ class FlowEngine(PyRunner):
         set_num_threads(self._threads or O.numThreads)
         self._check_time_step(O.dt)
         # One list per axis over all bodies (YADE's cheapest bulk read), gathered in C++.
-        coords = [_coordinates(axis)[0] for axis in range(3)]
-        pos = gather_positions(coords[0], coords[1], coords[2], self._rows)
+        pos, walls = self._read_positions()
         remeshing = core.remesh_due()
         try:
-            core.step(pos, self._radii, self._walls(coords, pos), O.dt)
+            core.step(pos, self._radii, walls, O.dt)
         except ValueError as error:  # name bodies by their YADE id, not by sphere index
             ids = self._ids
             message = re.sub(r"sphere (\d+)", lambda m: f"sphere #{ids[int(m.group(1))]}", str(error))

@@ -15,6 +15,7 @@ TEST(ParallelSubstitution, MatchesCholmodSolve) {
   for (int n : {50, 600}) {
     const auto p = test::random_packing(n, 61, 0.02, 0.03);
     FlowEngine e = test::permeameter(1);
+    e.settings.mixed_precision = false;  // the double factor: CHOLMOD's serial solve is the reference
     e.step(p.centre, p.radius, p.walls, 1.0);
     auto& solver = const_cast<CholmodSolver&>(e.cholmod());
     const int nu = e.system().n_unknowns();

@@ -2,7 +2,7 @@
 
     PYTHONPATH=build/python OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 \\
         /usr/bin/python3.11 bench/tradeoffs.py [--quick] [--out=doc/tradeoffs.md] [--jobs=2]
-        [--sizes=1000,8000] [--rounds=3] [--figure=doc/figures/tradeoffs.png] [--work=/tmp/trade]
+        [--sizes=1000,5000] [--rounds=3] [--figure=doc/figures/tradeoffs.png] [--work=/tmp/trade]
         [--report-only]      (re-render the report from the part files in --work, no measurement)
         [--part=SCENE:N]     (internal: measure one scene at one size, write --work/part_SCENE_N.json)
 
@@ -506,7 +506,7 @@ def main():
     quick = option('quick', False)
     work = option('work', '/tmp/trade')
     os.makedirs(work, exist_ok=True)
-    sizes = [int(s) for s in option('sizes', '250,1000' if quick else '1000,8000').split(',')]
+    sizes = [int(s) for s in option('sizes', '250,1000' if quick else '1000,5000').split(',')]
     rounds = option('rounds', 2 if quick else 3)
     part = option('part', '')
     if part:

@@ -3,7 +3,8 @@
 
     yade-double -n -x examples/oedometer.py [--quick] [--engine=pfv|yade] [--nonlinear]
                                             [--drainage=top|both] [--out=DIR] [--set=NAME=VALUE ...]
-    yade-double examples/oedometer.py                  # same, with the GUI and live plots
+    yade-double examples/oedometer.py                  # same, with the GUI: controller, 3D view, live U and p_mid plots
+    xvfb-run -a yade-double -x examples/oedometer.py --quick   # the GUI on a virtual display, leaves at the end
     yade-double -n -x examples/oedometer.py --compare=DIR_A,DIR_B [--out=DIR]   # plot two runs together
 
 Thesis section 4.4 (spec ../shared/model-spec.md section 8). The script
@@ -103,6 +104,25 @@ HEADLESS = bool(getattr(runtime.opts, 'nogui', True)) or not getattr(runtime, 'h
 
 def log(*args):
     print('oedometer:', *args, flush=True)
+
+
+def advance(steps):
+    """O.run(steps) to the end. With the GUI, YADE runs this script in the Qt main thread: waiting in O.run(n, True)
+    would freeze the 3D view, the controller and the live plots until the script ends. So the steps run in YADE's
+    background thread (exactly the same steps) while the main thread keeps the GUI alive. Pressing Stop in the
+    controller ends the script (it cannot tell a pause from a failed step)."""
+    if HEADLESS:
+        O.run(steps, True)
+        return
+    from PyQt5.QtWidgets import QApplication
+    target = O.iter + steps
+    O.run(steps)
+    while O.running:
+        QApplication.processEvents()
+        time.sleep(0.01)
+    if O.iter < target:
+        raise RuntimeError('oedometer: the run stopped at iteration %d before %d (Stop pressed, or a step failed)'
+                           % (O.iter, target))
 
 
 # ---------------------------------------------------------------- Terzaghi -----------------------------------
@@ -258,11 +278,11 @@ def settle(triax, goal, P, tol=0.005, unb=0.01, chunk=200, max_iter=400000):
     triax.goal2 = -goal
     start = O.iter
     while True:
-        O.run(chunk, True)
+        advance(chunk)
         if abs(top_stress() - goal) < tol * P['small_load'] and utils.unbalancedForce() < unb:
             # the wall stress can pass through the goal while the packing still moves: confirm on a second chunk
             h = height()
-            O.run(chunk, True)
+            advance(chunk)
             if abs(height() - h) < 1e-3 * P['small_load'] / P['young'] * h and \
                     abs(top_stress() - goal) < tol * P['small_load']:
                 return
@@ -302,7 +322,7 @@ def prepare(P):
         e.ompThreads = 1
     triax.goal1 = triax.goal2 = triax.goal3 = -P['sigma0']
     while True:  # isotropic compaction by particle growth
-        O.run(500, True)
+        advance(500)
         if utils.unbalancedForce() < 0.005 and abs(P['sigma0'] + triax.meanStress) / P['sigma0'] < 0.005:
             break
         if O.iter > 500000:
@@ -415,7 +435,7 @@ def permeameter(flow, P, triax):
     flow.bndCondIsPressure = [False, False, True, True, False, False]
     flow.bndCondValue = [0, 0, P['perm_dp'], 0, 0, 0]
     flow.updateTriangulation = True
-    O.run(2, True)
+    advance(2)
     q_in, q_out = flow.getBoundaryFlux(BOTTOM), flow.getBoundaryFlux(TOP)
     for b, (dofs, vel, ang) in zip(spheres, saved):
         b.state.blockedDOFs, b.state.vel, b.state.angVel = dofs, vel, ang
@@ -436,6 +456,9 @@ def run(opts):
     os.makedirs(out, exist_ok=True)
     wall0 = time.time()
     meta = prepare(P)
+    if not HEADLESS:  # the 3D view (the controller is opened by YADE)
+        from yade import qt
+        qt.View()
     dry_eps = P['small_load'] / meta['E_oed'] if not opts['nonlinear'] else dry_nonlinear(P, meta)
 
     # --- switch the fluid on -------------------------------------------------------------------------------
@@ -485,8 +508,10 @@ def run(opts):
     iso_left = [T for T in P['isochrones'] if T <= P['Tv_end'] * (1 + 1e-9)]
     if not HEADLESS:
         from yade import plot
-        plot.plots = {'Tv': ('U_sim', 'U_theory'), 'Tv ': ('p_mid', 'p_mid_theory')}
-        plot.plot(subPlots=True)
+        plot.plots = {'Tv': ('U_sim', 'U_theory'), 'Tv ': ('p_mid', 'p_mid_theory')}  # p_mid: / load
+        plot.plot(subPlots=True)  # shown and refreshed live by yade.plot
+        for a in {ref.line.axes for ref in plot.currLineRefs}:
+            a.set_xscale('log')
     # drained volume: outflow through the drained walls, accumulated every step (fluid volume balance check)
     drained = [0.0]
     faces = [TOP] + ([BOTTOM] if P['drainage'] == 'both' else [])
@@ -501,7 +526,7 @@ def run(opts):
     for T in targets:
         steps = max(1, int(math.ceil((t0 + T * t_c - O.time) / O.dt)))
         t_run = time.time()
-        O.run(steps, True)
+        advance(steps)
         wall_flow += time.time() - t_run
         t = O.time - t0
         H = height()
@@ -560,6 +585,14 @@ def run(opts):
                    coupled_wall_seconds=wall_flow, ms_per_step=1e3 * wall_flow / max(1, O.iter - it0))
     if opts['engine'] == 'pfv':
         summary['remesh_count'] = flow.core.remesh_count
+        # the engine's collective viscous limit, recomputed at every remesh (doc/validation.md section 4)
+        hist = [h for h in flow.collective_viscous_history if math.isfinite(h['limit'])]  # not the permeameter's
+        summary['collective_limit_over_dt'] = [h['limit'] / O.dt for h in hist]
+        summary['collective_limit_seconds'] = [h['seconds'] for h in hist]
+        if hist:
+            log('collective viscous limit / O.dt: first %.3f, last %.3f, lowest %.3f (%d meshes; the engine '
+                'warns below %.3f)' % (hist[0]['limit'] / O.dt, hist[-1]['limit'] / O.dt,
+                                       min(h['limit'] for h in hist) / O.dt, len(hist), 1 / flow.time_step_safety))
     if opts['nonlinear']:
         K1, _, _ = permeameter(flow, P, triax)
         E_sec = P['load'] / dry_eps

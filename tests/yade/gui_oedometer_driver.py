@@ -2,7 +2,7 @@
 
     xvfb-run -a -s "-screen 0 1600x1000x24" yade-double -j1 -x tests/yade/gui_oedometer_driver.py OUTDIR [example args]
 
-Every second, while the example runs, a Qt timer lists the visible top-level windows, the iteration reached and the
+Every half second, while the example runs, a Qt timer lists the visible top-level windows, the iteration reached and the
 number of points of the live plot, tiles the windows (Xvfb has no window manager: all would open at (0, 0)) and
 saves a screenshot of the whole screen to OUTDIR/screen.png (the last one taken while the coupled phase ran).
 At the end it writes OUTDIR/gui.json. The example itself writes OUTDIR/run/summary.json.
@@ -46,7 +46,7 @@ def tick():
 
 timer = QTimer()
 timer.timeout.connect(tick)
-timer.start(1000)
+timer.start(500)
 sys.argv = [EXAMPLE, '--out=' + os.path.join(out, 'run')] + sys.argv[2:]
 status = 'ok'
 try:

@@ -3,12 +3,12 @@
     yade-double -n -x tests/yade/test_oedometer_gui.py        (exit 0 = pass, 1 = fail, 77 = skipped: no xvfb-run)
 
 Runs tests/yade/gui_oedometer_driver.py (which runs the example) with `xvfb-run -a yade-double -j1 -x` on the quick
-sample up to T_v = 0.1 (-x: YADE leaves after the script instead of opening its IPython prompt; stdin is /dev/null
+sample up to T_v = 0.2 (-x: YADE leaves after the script instead of opening its IPython prompt; stdin is /dev/null
 as well), then the same run headless, and checks:
 * the run completes (exit 0, within a timeout) in GUI mode (YADE saw a display);
 * YADE's controller, its 3D view and the example's live matplotlib figure were on screen while the coupled phase ran;
 * the GUI stayed live during the run (the example steps in YADE's background thread and keeps processing Qt events):
-  the driver's one-second timer fired while the iterations advanced and the live plot gained points;
+  the driver's half-second timer fired while the iterations advanced and the live plot gained points;
 * the GUI run gives exactly the numbers of the headless run (same steps).
 A screenshot of the last second of the run is left in the output directory when a check fails.
 """
@@ -22,7 +22,7 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(sys.argv[0]))
 DRIVER = os.path.join(HERE, 'gui_oedometer_driver.py')
 EXAMPLE = os.path.normpath(os.path.join(HERE, '..', '..', 'examples', 'oedometer.py'))
-ARGS = ['--quick', '--set=Tv_end=0.1']
+ARGS = ['--quick', '--set=Tv_end=0.2']
 KEYS = ('K', 'Cv', 'steps', 'final_U', 'U_max_abs_error', 'isochrone_rms_error', 'mid_pressure_rms_error')
 failures = []
 
@@ -69,7 +69,7 @@ def main():
     iters = [t['iter'] for t in running]
     points = [t['points'] for t in running]
     check(len(running) >= 3 and iters[-1] > iters[0] and points[-1] > points[0],
-          'GUI live during the run: %d one-second ticks while running, iterations %s .. %s, plot points %s .. %s'
+          'GUI live during the run: %d half-second ticks while running, iterations %s .. %s, plot points %s .. %s'
           % (len(running), iters[0] if iters else '-', iters[-1] if iters else '-', points[0] if points else '-',
              points[-1] if points else '-'))
     check(os.path.exists(os.path.join(out, 'gui', 'screen.png')), 'screenshot taken')

@@ -3,7 +3,8 @@
 
     yade-double -n -x examples/oedometer.py [--quick] [--engine=pfv|yade] [--nonlinear]
                                             [--drainage=top|both] [--out=DIR] [--set=NAME=VALUE ...]
-    yade-double examples/oedometer.py                  # same, with the GUI and live plots
+    yade-double examples/oedometer.py                  # same, with the GUI: controller, 3D view, live U and p_mid plots
+    xvfb-run -a yade-double -x examples/oedometer.py --quick   # the GUI on a virtual display, leaves at the end
     yade-double -n -x examples/oedometer.py --compare=DIR_A,DIR_B [--out=DIR]   # plot two runs together
 
 Thesis section 4.4 (spec ../shared/model-spec.md section 8). The script
@@ -105,6 +106,25 @@ def log(*args):
     print('oedometer:', *args, flush=True)
 
 
+def advance(steps):
+    """O.run(steps) to the end. With the GUI, YADE runs this script in the Qt main thread: waiting in O.run(n, True)
+    would freeze the 3D view, the controller and the live plots until the script ends. So the steps run in YADE's
+    background thread (exactly the same steps) while the main thread keeps the GUI alive. Pressing Stop in the
+    controller ends the script (it cannot tell a pause from a failed step)."""
+    if HEADLESS:
+        O.run(steps, True)
+        return
+    from PyQt5.QtWidgets import QApplication
+    target = O.iter + steps
+    O.run(steps)
+    while O.running:
+        QApplication.processEvents()
+        time.sleep(0.01)
+    if O.iter < target:
+        raise RuntimeError('oedometer: the run stopped at iteration %d before %d (Stop pressed, or a step failed)'
+                           % (O.iter, target))
+
+
 # ---------------------------------------------------------------- Terzaghi -----------------------------------
 _M = (2 * np.arange(4000) + 1) * np.pi / 2
 
@@ -150,6 +170,63 @@ class Terzaghi:
         if d <= 0:
             return 0.0
         return float(terzaghi_p([d / self.L], self.Cv * t / self.L ** 2)[0])
+
+
+class VariableK:
+    """Terzaghi's problem with a conductivity that falls with the compaction (the --nonlinear reference).
+
+    K falls linearly with the local strain from K_init (before the load) to K_final (measured after the full load),
+    at the constant secant modulus: with w = excess pressure / load the local strain is (1 - w) times the final one, so
+    dw/dt = d/dz (c(w) dw/dz), c(w) = C_v,init (1 + (r - 1)(1 - w)), r = C_v,final / C_v,init; drained face(s) w = 0,
+    w = 1 at t = 0. Small strain (fixed height H). Finite volumes (n cells over the drainage length), explicit steps
+    of a fifth of the diffusive limit; profiles are kept at the requested times. With r = 1 it is Terzaghi's series
+    to 2e-4 in U (n = 80)."""
+
+    def __init__(self, drainage, H, cv_init, cv_final, times, n=80):
+        self.drainage, self.H = drainage, H
+        L = H if drainage == 'top' else H / 2
+        dz, r = L / n, cv_final / cv_init
+        w = np.ones(n)
+        dt_max = 0.2 * dz * dz / max(cv_init, cv_final)
+        t, self.times, self.profiles = 0.0, [], []
+        for target in sorted(set(float(x) for x in times)):
+            while t < target - 1e-15:
+                dt = min(dt_max, target - t)
+                c = cv_init * (1 + (r - 1) * (1 - w))
+                flux = np.empty(n + 1)  # at the faces, towards the drained face (index 0)
+                flux[0] = c[0] * w[0] / (dz / 2)
+                flux[1:n] = 0.5 * (c[:-1] + c[1:]) * (w[1:] - w[:-1]) / dz
+                flux[n] = 0.0  # impermeable bottom (top drainage) or the plane of symmetry (both)
+                w = w + dt * (flux[1:] - flux[:-1]) / dz
+                t += dt
+            self.times.append(target)
+            self.profiles.append(w.copy())
+        self.d = (np.arange(n) + 0.5) * dz  # distance of the cell centres from the drained face
+
+    def _w(self, t):
+        return self.profiles[int(np.argmin(np.abs(np.asarray(self.times) - t)))]
+
+    def U(self, t):
+        return float(1 - self._w(t).mean())
+
+    def p(self, rel, t):
+        """p / load at height rel * H above the bottom."""
+        d = (1 - rel) * self.H if self.drainage == 'top' else min(rel, 1 - rel) * self.H
+        return float(np.interp(d, np.concatenate([[0.0], self.d]), np.concatenate([[0.0], self._w(t)])))
+
+
+def variable_k_errors(s, rows, iso):
+    """The --nonlinear run against VariableK (its own K_init, K_final, E_oed secant): U_theory_variable_K in the rows,
+    error figures returned (same window as the others)."""
+    ref = VariableK(s['drainage'], s['H0'], s['K'] * s['E_oed_secant'] / s['parameters']['gamma_w'], s['Cv_final'],
+                    [r['t'] for r in rows] + [r['Tv'] * s['t_Tv1'] for r in iso])
+    for r in rows:
+        r['U_theory_variable_K'] = ref.U(r['t'])
+    win = [r for r in rows if r['Tv'] >= s['error_window_Tv_min']]
+    iso_win = [r for r in iso if r['Tv'] >= s['error_window_Tv_min']]
+    e_iso = [r['p_over_load'] - ref.p(r['z_over_H'], r['Tv'] * s['t_Tv1']) for r in iso_win]
+    return dict(U_max_abs_error_variable_K=max(abs(r['U_sim'] - r['U_theory_variable_K']) for r in win),
+                isochrone_rms_error_variable_K=math.sqrt(sum(e * e for e in e_iso) / len(e_iso)))
 
 
 # ---------------------------------------------------------------- options -----------------------------------
@@ -258,11 +335,11 @@ def settle(triax, goal, P, tol=0.005, unb=0.01, chunk=200, max_iter=400000):
     triax.goal2 = -goal
     start = O.iter
     while True:
-        O.run(chunk, True)
+        advance(chunk)
         if abs(top_stress() - goal) < tol * P['small_load'] and utils.unbalancedForce() < unb:
             # the wall stress can pass through the goal while the packing still moves: confirm on a second chunk
             h = height()
-            O.run(chunk, True)
+            advance(chunk)
             if abs(height() - h) < 1e-3 * P['small_load'] / P['young'] * h and \
                     abs(top_stress() - goal) < tol * P['small_load']:
                 return
@@ -302,7 +379,7 @@ def prepare(P):
         e.ompThreads = 1
     triax.goal1 = triax.goal2 = triax.goal3 = -P['sigma0']
     while True:  # isotropic compaction by particle growth
-        O.run(500, True)
+        advance(500)
         if utils.unbalancedForce() < 0.005 and abs(P['sigma0'] + triax.meanStress) / P['sigma0'] < 0.005:
             break
         if O.iter > 500000:
@@ -415,7 +492,7 @@ def permeameter(flow, P, triax):
     flow.bndCondIsPressure = [False, False, True, True, False, False]
     flow.bndCondValue = [0, 0, P['perm_dp'], 0, 0, 0]
     flow.updateTriangulation = True
-    O.run(2, True)
+    advance(2)
     q_in, q_out = flow.getBoundaryFlux(BOTTOM), flow.getBoundaryFlux(TOP)
     for b, (dofs, vel, ang) in zip(spheres, saved):
         b.state.blockedDOFs, b.state.vel, b.state.angVel = dofs, vel, ang
@@ -436,6 +513,9 @@ def run(opts):
     os.makedirs(out, exist_ok=True)
     wall0 = time.time()
     meta = prepare(P)
+    if not HEADLESS:  # the 3D view (the controller is opened by YADE)
+        from yade import qt
+        qt.View()
     dry_eps = P['small_load'] / meta['E_oed'] if not opts['nonlinear'] else dry_nonlinear(P, meta)
 
     # --- switch the fluid on -------------------------------------------------------------------------------
@@ -485,8 +565,10 @@ def run(opts):
     iso_left = [T for T in P['isochrones'] if T <= P['Tv_end'] * (1 + 1e-9)]
     if not HEADLESS:
         from yade import plot
-        plot.plots = {'Tv': ('U_sim', 'U_theory'), 'Tv ': ('p_mid', 'p_mid_theory')}
-        plot.plot(subPlots=True)
+        plot.plots = {'Tv': ('U_sim', 'U_theory'), 'Tv ': ('p_mid', 'p_mid_theory')}  # p_mid: / load
+        plot.plot(subPlots=True)  # shown and refreshed live by yade.plot
+        for a in {ref.line.axes for ref in plot.currLineRefs}:
+            a.set_xscale('log')
     # drained volume: outflow through the drained walls, accumulated every step (fluid volume balance check)
     drained = [0.0]
     faces = [TOP] + ([BOTTOM] if P['drainage'] == 'both' else [])
@@ -501,7 +583,7 @@ def run(opts):
     for T in targets:
         steps = max(1, int(math.ceil((t0 + T * t_c - O.time) / O.dt)))
         t_run = time.time()
-        O.run(steps, True)
+        advance(steps)
         wall_flow += time.time() - t_run
         t = O.time - t0
         H = height()
@@ -560,6 +642,14 @@ def run(opts):
                    coupled_wall_seconds=wall_flow, ms_per_step=1e3 * wall_flow / max(1, O.iter - it0))
     if opts['engine'] == 'pfv':
         summary['remesh_count'] = flow.core.remesh_count
+        # the engine's collective viscous limit, recomputed at every remesh (doc/validation.md section 4)
+        hist = [h for h in flow.collective_viscous_history if math.isfinite(h['limit'])]  # not the permeameter's
+        summary['collective_limit_over_dt'] = [h['limit'] / O.dt for h in hist]
+        summary['collective_limit_seconds'] = [h['seconds'] for h in hist]
+        if hist:
+            log('collective viscous limit / O.dt: first %.3f, last %.3f, lowest %.3f (%d meshes; the engine '
+                'warns below %.3f)' % (hist[0]['limit'] / O.dt, hist[-1]['limit'] / O.dt,
+                                       min(h['limit'] for h in hist) / O.dt, len(hist), 1 / flow.time_step_safety))
     if opts['nonlinear']:
         K1, _, _ = permeameter(flow, P, triax)
         E_sec = P['load'] / dry_eps
@@ -570,10 +660,13 @@ def run(opts):
         summary.update(K_final=K1, E_oed_secant=E_sec, Cv_final=Cv1, dry_strain=dry_eps,
                        U_max_abs_error_final_Cv=max(abs(r['U_sim'] - r['U_theory_final_Cv']) for r in win),
                        final_strain=(H0 - rows[-1]['height']) / H0)
+        summary.update(variable_k_errors(summary, rows, iso))
         log('nonlinear: K_init %.5g K_final %.5g m/s, E_oed init %.5g secant %.5g Pa, C_v init %.5g final %.5g m2/s'
             % (K0, K1, E_oed, E_sec, Cv, Cv1))
-        log('nonlinear: max |U_sim - U_theory| with C_v,init %.4f, with C_v,final %.4f'
-            % (summary['U_max_abs_error'], summary['U_max_abs_error_final_Cv']))
+        log('nonlinear: max |U_sim - U_theory| with C_v,init %.4f, with C_v,final %.4f, with K falling with the '
+            'strain %.4f (isochrones %.4f)' % (summary['U_max_abs_error'], summary['U_max_abs_error_final_Cv'],
+                                               summary['U_max_abs_error_variable_K'],
+                                               summary['isochrone_rms_error_variable_K']))
     summary['total_wall_seconds'] = time.time() - wall0
 
     write_csv(os.path.join(out, 'timeseries.csv'), rows)
@@ -635,6 +728,9 @@ def plot_runs(runs, path):
         if 'U_theory_final_Cv' in rows[0]:
             ax[0].semilogx([r['Tv'] for r in rows], [r['U_theory_final_Cv'] for r in rows], '--',
                            label='Terzaghi with C_v,final (%s)' % label)
+        if 'U_theory_variable_K' in rows[0]:
+            ax[0].semilogx([r['Tv'] for r in rows], [r['U_theory_variable_K'] for r in rows], '-.',
+                           label='K falling with the strain (%s, max err %.3f)' % (label, summ['U_max_abs_error_variable_K']))
         ax[1].semilogx([r['Tv'] for r in rows], [r['p_mid'] / summ['parameters']['load'] for r in rows], m, ms=3.5,
                        mfc='none', label='%s (RMS %.3f)' % (label, summ['mid_pressure_rms_error']))
         for j, T in enumerate(sorted(set(r['Tv_target'] for r in iso))):
@@ -664,25 +760,32 @@ def compare(dirs, out):
         with open(os.path.join(d, 'summary.json')) as f:
             s = json.load(f)
         runs.append((s['engine'], read_csv(os.path.join(d, 'timeseries.csv')), read_csv(os.path.join(d, 'isochrones.csv')), s))
+        if 'Cv_final' in s:  # recomputed: runs of older versions lack it
+            s.update(variable_k_errors(s, runs[-1][1], runs[-1][2]))
     os.makedirs(out, exist_ok=True)
     plot_runs(runs, os.path.join(out, 'oedometer-comparison.png'))
     print('| engine | K [m/s] | E_oed [Pa] | C_v [m2/s] | steps | max abs(U_sim - U_th) | RMS isochrones / load | '
-          'RMS p_mid / load | final U | max abs dU, drained layer | RMS isochrones, drained layer | ms/step |')
-    print('|---|---|---|---|---|---|---|---|---|---|---|---|')
+          'RMS p_mid / load | final U | max abs dU, drained layer | RMS isochrones, drained layer | '
+          'whole curve: max abs dU / RMS isochrones | drained / settled volume | ms/step |')
+    print('|---|---|---|---|---|---|---|---|---|---|---|---|---|---|')
     for label, rows, iso, s in runs:
-        print('| %s | %.4g | %.4g | %.4g | %d | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %.2f |' % (
+        print('| %s | %.4g | %.4g | %.4g | %d | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f / %.4f | %.4f | %.2f |' % (
             label, s['K'], s['E_oed'], s['Cv'], s['steps'], s['U_max_abs_error'], s['isochrone_rms_error'],
             s['mid_pressure_rms_error'], s['final_U'], s['U_max_abs_error_layer'], s['isochrone_rms_error_layer'],
+            s['U_max_abs_error_all'], s['isochrone_rms_error_all'], s['drained_over_settlement_volume_end'],
             s['ms_per_step']))
     if all('Cv_final' in r[3] for r in runs):
         print()
         print('| engine | K_init [m/s] | K_final [m/s] | E_oed init [Pa] | E_oed secant [Pa] | C_v init [m2/s] | '
-              'C_v final [m2/s] | max abs dU, C_v init | max abs dU, C_v final | final strain | dry strain |')
-        print('|---|---|---|---|---|---|---|---|---|---|---|')
+              'C_v final [m2/s] | max abs dU, C_v init | max abs dU, C_v final | RMS isochrones, C_v init | '
+              'max abs dU, K(strain) | RMS isochrones, K(strain) | final strain | dry strain | drained / settled |')
+        print('|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|')
         for label, rows, iso, s in runs:
-            print('| %s | %.4g | %.4g | %.4g | %.4g | %.4g | %.4g | %.4f | %.4f | %.4f | %.4f |' % (
-                label, s['K'], s['K_final'], s['E_oed'], s['E_oed_secant'], s['Cv'], s['Cv_final'],
-                s['U_max_abs_error'], s['U_max_abs_error_final_Cv'], s['final_strain'], s['dry_strain']))
+            print('| %s | %.4g | %.4g | %.4g | %.4g | %.4g | %.4g | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | '
+                  '%.4f |' % (label, s['K'], s['K_final'], s['E_oed'], s['E_oed_secant'], s['Cv'], s['Cv_final'],
+                              s['U_max_abs_error'], s['U_max_abs_error_final_Cv'], s['isochrone_rms_error'],
+                              s['U_max_abs_error_variable_K'], s['isochrone_rms_error_variable_K'],
+                              s['final_strain'], s['dry_strain'], s['drained_over_settlement_volume_end']))
 
 
 def main():

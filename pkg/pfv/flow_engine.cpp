@@ -232,7 +232,8 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   has_prev_ = true;
 }
 
-double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations) const {
+double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations,
+                                           std::vector<Vec3>* mode) const {
   if (!has_mesh() || !has_prev_) throw std::logic_error("the stability limit needs a mesh: run a step first");
   const int n = mesh().n_spheres, nc = mesh().n_cells();
   if (static_cast<int>(mass.size()) != n) bad_input("one mass per sphere is needed");
@@ -241,14 +242,21 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
   const bool direct = linear_.cholmod->ready();
   if (nu == 0 || (!direct && !linear_.pcg.ready() && settings.use_solver != 0)) return HUGE_VAL;
 
-  // Velocity probe: unit norm over the moving spheres, deterministic start.
+  // Velocity probe: unit norm over the moving spheres; the given mode, else a deterministic start.
   std::vector<Vec3> v(n, Vec3::Zero()), shifted(centres_prev_);
   double norm = 0;
-  for (int k = 0; k < n; ++k)
-    if (mass[k] > 0) {
-      v[k] = Vec3(std::sin(1.0 + 3.1 * k), std::cos(2.0 + 1.7 * k), std::sin(0.5 + 2.3 * k));
-      norm += v[k].squaredNorm();
-    }
+  if (mode && static_cast<int>(mode->size()) == n)
+    for (int k = 0; k < n; ++k)
+      if (mass[k] > 0 && (*mode)[k].allFinite()) {
+        v[k] = (*mode)[k];
+        norm += v[k].squaredNorm();
+      }
+  if (norm == 0)
+    for (int k = 0; k < n; ++k)
+      if (mass[k] > 0) {
+        v[k] = Vec3(std::sin(1.0 + 3.1 * k), std::cos(2.0 + 1.7 * k), std::sin(0.5 + 2.3 * k));
+        norm += v[k].squaredNorm();
+      }
   if (norm == 0) return HUGE_VAL;
   double h = 0;  // probe displacement: a tiny fraction of the box
   for (int a = 0; a < 3; ++a) h = std::max(h, walls_prev_.extent(a));
@@ -290,6 +298,10 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
     }
     lambda = std::sqrt(a_norm);  // |M^-1 V v| for |v| = 1
     if (lambda == 0) return HUGE_VAL;
+  }
+  if (mode) {
+    for (Vec3& u : v) u /= lambda;
+    *mode = std::move(v);
   }
   return 2.0 / lambda;
 }

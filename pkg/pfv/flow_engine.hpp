@@ -52,7 +52,10 @@ class FlowEngine {
   // (dV/dt -> solve -> forces, plus the viscous shear term when on). Power iteration from the last step's positions; masses <= 0
   // mark spheres that do not move. Collective modes (groups of spheres squeezing shared
   // pores) make this smaller than the thesis' single-particle dt_MV. Needs a mesh.
-  double viscous_stability_limit(const std::vector<double>& mass, int iterations) const;
+  // mode: if given with one entry per sphere (not all zero), the iteration starts from it
+  // (warm start from the previous mesh's mode); on return it holds the last iterate.
+  double viscous_stability_limit(const std::vector<double>& mass, int iterations,
+                                 std::vector<Vec3>* mode = nullptr) const;
 
   // Results of the last step.
   const std::vector<Vec3>& forces() const { return force_; }  // spheres, then six walls

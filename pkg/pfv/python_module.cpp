@@ -254,6 +254,19 @@ PYBIND11_MODULE(_core, m) {
              py::gil_scoped_release release;
              return e.viscous_stability_limit(m, iterations);
            }, py::arg("masses"), py::arg("iterations") = 40)
+      .def("viscous_stability_mode", [](const FlowEngine& e, const Array& mass, int iterations, py::object start) {
+             auto m = to_vector(mass, "masses");
+             std::vector<Vec3> mode;
+             if (!start.is_none()) mode = to_points(start.cast<Array>(), "start");
+             double limit;
+             {
+               py::gil_scoped_release release;
+               limit = e.viscous_stability_limit(m, iterations, &mode);
+             }
+             return py::make_tuple(limit, points_to_array(mode));
+           }, py::arg("masses"), py::arg("iterations") = 40, py::arg("start") = py::none(),
+           "(limit, mode): as viscous_stability_limit, started from `start` (one velocity per sphere, e.g. the\n"
+           "mode returned on the previous mesh) when given; mode is the last iterate.")
       .def("forces", [](const FlowEngine& e) { return points_to_array(e.forces()); },
            "Fluid force on every sphere (input order), then on the six walls.")
       .def("shear_forces", [](const FlowEngine& e) { return points_to_array(e.shear_forces()); },

@@ -20,6 +20,11 @@ Checks
    operator, 2 / lambda_max of M^-1 V), which is below dt_MV on this dense packing (the thesis' 0.8 dt_MV blows up
    here within 20 steps). O.dt = time_step_safety * critical_time_step, the largest step the engine accepts silently,
    is stable by the same criterion, and no warning is given.
+6. The collective limit is recomputed at every remesh (warm-started power iteration). The packing compacted by 1 %
+   (positions scaled about the centre, walls with them, relaxed without fluid) has a lower limit. A run at the step
+   the engine accepted silently on the loose packing is moved onto the compacted one and remeshed: the engine warns
+   once, at that step (it had been safe until then), and the run then blows up; with strict_time_step the remesh
+   step raises; time_step_safety * critical_time_step of the compacted packing is stable without a warning.
 """
 import math
 import os
@@ -47,6 +52,7 @@ def check(ok, text):
 
 
 _relaxed = []
+COMPACTION = 0.99  # scale factor of the positions (walls included) about the centre of the box
 
 
 def build():
@@ -64,6 +70,18 @@ def build():
             b.state.vel = Vector3(0, 0, 0)
             b.state.angVel = Vector3(0, 0, 0)
         O.saveTmp("relaxed")
+        # The same packing compacted: positions (walls included) scaled about the centre, relaxed again.
+        centre = Vector3(0.5, 0.5, 0.5)
+        for b in O.bodies:
+            b.state.pos = centre + (b.state.pos - centre) * COMPACTION
+        newton.damping = 0.5
+        O.run(1000, True)
+        print("     compacted packing relaxed without fluid: unbalanced force %.2g" % utils.unbalancedForce())
+        newton.damping = 0.0
+        for b in O.bodies:
+            b.state.vel = Vector3(0, 0, 0)
+            b.state.angVel = Vector3(0, 0, 0)
+        O.saveTmp("compacted")
         _relaxed.append(True)
     O.loadTmp("relaxed")
     flow = FlowEngine(label="flow")
@@ -71,11 +89,26 @@ def build():
     flow.bndCondIsPressure = [False, False, False, True, False, False]  # drained top only
     flow.bndCondValue = [0.0] * 6
     scenes.insert_flow(flow)
+    random_velocities()
+    return flow
+
+
+def compact(flow):
+    """Replace the scene by the compacted packing (at rest, its own contacts), keep the same flow engine and O.dt and
+    have it remesh there; the jump is not a pore-volume change (no dV/dt term for it)."""
+    dt = O.dt
+    O.loadTmp("compacted")
+    scenes.insert_flow(flow)
+    O.dt = dt
+    flow.updateTriangulation = True
+    flow.core.reset_history()
+
+
+def random_velocities():
     rng = random.Random(7)
     for b in O.bodies:
         if isinstance(b.shape, Sphere):
             b.state.vel = Vector3(rng.gauss(0, V0), rng.gauss(0, V0), rng.gauss(0, V0))
-    return flow
 
 
 def kinetic():
@@ -165,8 +198,11 @@ check(direct is not None, "strict_time_step: the engine's check raises ValueErro
 flow.strict_time_step = False
 
 # 4. a small enough step is stable (control: the scene and the criterion are sound) --------------------------------
-def stable_run(factor, label):
-    flow = build()
+def stable_run(factor, label, flow=None):
+    if flow is None:
+        flow = build()
+    else:
+        random_velocities()
     O.dt = factor * flow.viscous_time_step
     ke0 = kinetic()
     hist, seen, error = run_steps(300, ke0, stop_ratio=1e12)
@@ -195,6 +231,69 @@ factor = flow.time_step_safety * flow.critical_time_step / flow.viscous_time_ste
 ok, seen = stable_run(factor, "engine limit")
 check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
       "no TimeStepWarning at O.dt = time_step_safety * critical_time_step = %.3g dt_MV" % factor)
+
+# 6. the limit follows the compaction: recomputed at the remesh, warned there -------------------------------------------
+flow = build()
+O.dt = 1e-3 * flow.viscous_time_step
+O.step()
+loose = flow.collective_viscous_time_step
+O.dt = flow.time_step_safety * flow.critical_time_step  # accepted silently on the loose packing (stable, check 5)
+factor = O.dt / dt_mv
+random_velocities()
+hist, seen, error = run_steps(5, kinetic())
+check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)], "loose packing at %.3g dt_MV: no warning"
+      % factor)
+compact(flow)
+random_velocities()
+ke0 = kinetic()
+it0 = O.iter
+hist, seen, error = run_steps(100, ke0, stop_ratio=1e12)
+history = flow.collective_viscous_history
+dt_warnings = [(i - it0, w) for i, w in seen if issubclass(w.category, TimeStepWarning)]
+print("     collective limit: %s" % "; ".join(
+    "%.3f dt_MV at iter %d (%d iterations, %s, %.1f ms)" % (h["limit"] / dt_mv, h["iter"], h["iterations"],
+                                                            "warm" if h["warm"] else "cold", 1e3 * h["seconds"])
+    for h in history))
+remesh = sum(flow.core.remesh_times().values())
+print("     last remesh %.1f ms; warm-started limit on the compacted packing %.1f ms (%.0f %% of it)"
+      % (1e3 * remesh, 1e3 * history[-1]["seconds"], 100 * history[-1]["seconds"] / remesh))
+# history[0]: the first mesh; history[1]: the remesh onto the compacted packing (a blown-up run may remesh again later)
+check(len(history) >= 2 and history[1]["warm"] and history[1]["iter"] == it0,
+      "the limit was recomputed (warm start) on the new mesh, at the remesh step")
+compacted = history[1]["limit"] if len(history) >= 2 else loose
+check(compacted < 0.85 * loose, "compaction by %g %% lowers the collective limit from %.3f to %.3f dt_MV"
+      % (100 * (1 - COMPACTION), loose / dt_mv, compacted / dt_mv))
+check(len(dt_warnings) == 1 and dt_warnings[0][0] == 1,
+      "one TimeStepWarning, at the remesh step (got %s)" % [k for k, _ in dt_warnings])
+grown = [k for k, r in enumerate(hist, 1) if r > 10]
+check(max(hist, default=0) > 1e6 and (not dt_warnings or not grown or dt_warnings[0][0] < grown[0]),
+      "the compacted packing at %.3g dt_MV (%.2f x its limit) blows up: max KE/KE0 %.3g, after the warning"
+      % (factor, O.dt / compacted, max(hist, default=0)))
+
+flow = build()
+O.dt = 1e-3 * flow.viscous_time_step
+O.step()
+O.dt = flow.time_step_safety * flow.critical_time_step
+O.step()
+flow.strict_time_step = True
+compact(flow)
+it0 = O.iter
+try:
+    O.step()
+    raised = None
+except RuntimeError as e:
+    raised = str(e)
+check(raised is not None and "collective viscous limit" in raised and O.iter == it0,
+      "strict_time_step: the remesh step on the compacted packing raises, O.iter unchanged")
+
+flow = build()
+O.dt = 1e-3 * flow.viscous_time_step
+O.step()
+compact(flow)
+O.step()
+ok, seen = stable_run(flow.time_step_safety * flow.critical_time_step / dt_mv, "compacted, its engine limit", flow)
+check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
+      "no TimeStepWarning at time_step_safety * critical_time_step of the compacted packing")
 
 print("%d failed" % len(failures))
 sys.exit(1 if failures else 0)

@@ -11,6 +11,7 @@ AttributeError. Nothing is silently ignored.
 """
 import ast
 import re
+import time
 import warnings
 import weakref
 
@@ -65,7 +66,8 @@ _INTERNAL = frozenset({
     "_core", "_key", "_ids", "_rows", "_radii", "_wall_rows", "_wall_half", "_n_bodies",
     "_boundary_use_max_min", "_wall_ids", "_warned", "_vertex_of_id", "_threads",
     "_mass_per_diameter", "_dt_dem", "_masses", "_dt_collective", "_collective_viscosity",
-    "time_step_safety", "strict_time_step", "_force_bridge",
+    "_collective_mesh", "_collective_mode", "_collective_history", "_dt_unsafe", "_force_bridge",
+    "time_step_safety", "strict_time_step", "collective_iterations", "collective_iterations_warm",
 })
 # YADE attributes PFV implements through a core attribute of another name (the others are
 # properties of FlowEngine below).
@@ -110,10 +112,19 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_mass_per_diameter", float("inf"))
         object.__setattr__(self, "_dt_dem", float("inf"))
         object.__setattr__(self, "_masses", None)
-        object.__setattr__(self, "_dt_collective", None)  # computed on the first mesh
+        # Collective viscous limit: computed on every new mesh (remesh_count changes) and when
+        # the viscosity changes; the power iteration of a remesh starts from the previous mesh's mode.
+        object.__setattr__(self, "_dt_collective", None)
         object.__setattr__(self, "_collective_viscosity", None)
-        # O.dt must stay below time_step_safety * min(dt_MV, DEM limit) (zeta of thesis 4.22);
-        # beyond it the engine warns once, or raises if strict_time_step.
+        object.__setattr__(self, "_collective_mesh", None)  # core.remesh_count it was computed on
+        object.__setattr__(self, "_collective_mode", None)
+        object.__setattr__(self, "_collective_history", [])
+        object.__setattr__(self, "collective_iterations", 40)       # cold start (first mesh)
+        object.__setattr__(self, "collective_iterations_warm", 10)  # warm start (later meshes)
+        # O.dt must stay below time_step_safety * min(dt_MV, collective limit, DEM limit) (zeta of
+        # thesis 4.22); beyond it the engine warns when the step becomes unsafe (the first time, and
+        # again after it was safe in between), or raises if strict_time_step.
+        object.__setattr__(self, "_dt_unsafe", False)
         object.__setattr__(self, "time_step_safety", 0.8)
         object.__setattr__(self, "strict_time_step", False)
         _engines[self._key] = self
@@ -308,8 +319,10 @@ class FlowEngine(PyRunner):
             ids = self._ids
             message = re.sub(r"sphere (\d+)", lambda m: f"sphere #{ids[int(m.group(1))]}", str(error))
             raise ValueError(f"pfv.FlowEngine: {message}") from None
-        if self._dt_collective is None:
-            self._check_time_step(O.dt)  # the collective limit needs the first mesh: check again
+        if self._collective_mesh != core.remesh_count:
+            # A new mesh (the first, or a remesh adopted by this step): its collective limit may be
+            # lower (a compacting sample), check again.
+            self._check_time_step(O.dt)
         if remeshing:
             hidden = core.hidden_spheres()
             if hidden:
@@ -331,15 +344,36 @@ class FlowEngine(PyRunner):
         """2 / lambda_max(M^-1 V) of the current mesh: the viscous limit of the explicit coupling
         for collective motions (groups of spheres squeezing shared pores), which the thesis'
         single-particle dt_MV overestimates (0.3-0.5 dt_MV measured on dense packings).
-        Computed by power iteration on the first mesh, and again when the viscosity changes."""
-        if not self._core.has_mesh():
+        Computed by power iteration on every new mesh and when the viscosity changes:
+        collective_iterations (40) from a fixed start on the first mesh, collective_iterations_warm
+        (10) started from the previous mesh's mode afterwards (each iteration costs one
+        back-substitution and one force evaluation; see collective_viscous_history)."""
+        core = self._core
+        if not core.has_mesh():
             return float("inf")
         # The shear term adds damping to the operator, so switching it recomputes the limit too.
-        key = (self._core.viscosity, self._core.viscous_shear and self._core.shear_forces().size > 0)
-        if self._dt_collective is None or self._collective_viscosity != key:
-            object.__setattr__(self, "_dt_collective", self._core.viscous_stability_limit(self._masses, 40))
+        key = (core.viscosity, core.viscous_shear and core.shear_forces().size > 0)
+        if self._collective_mesh != core.remesh_count or self._collective_viscosity != key:
+            mode = self._collective_mode
+            warm = mode is not None and len(mode) == len(self._masses) and self._dt_collective is not None
+            iterations = self.collective_iterations_warm if warm else self.collective_iterations
+            t0 = time.perf_counter()
+            limit, mode = core.viscous_stability_mode(self._masses, iterations, mode if warm else None)
+            seconds = time.perf_counter() - t0
+            object.__setattr__(self, "_dt_collective", limit)
+            object.__setattr__(self, "_collective_mode", mode if len(mode) else None)
             object.__setattr__(self, "_collective_viscosity", key)
+            object.__setattr__(self, "_collective_mesh", core.remesh_count)
+            self._collective_history.append(dict(
+                iter=yade.O.iter, remesh_count=core.remesh_count, limit=limit, iterations=iterations,
+                warm=warm, seconds=seconds))
         return self._dt_collective
+
+    @property
+    def collective_viscous_history(self):
+        """One dict per computation of the collective limit: iter, remesh_count, limit [s],
+        iterations, warm (started from the previous mode), seconds (wall time of the iteration)."""
+        return list(self._collective_history)
 
     @property
     def critical_time_step(self):
@@ -354,6 +388,7 @@ class FlowEngine(PyRunner):
         dt_collective = self.collective_viscous_time_step
         limit = self.time_step_safety * min(dt_mv, dt_collective, self._dt_dem)
         if dt <= limit:
+            object.__setattr__(self, "_dt_unsafe", False)
             return
         message = (f"pfv.FlowEngine: O.dt = {dt:.4g} exceeds the coupled stability limit "
                    f"{self.time_step_safety:g} x min(dt_MV = {dt_mv:.4g}, collective viscous limit = "
@@ -361,8 +396,8 @@ class FlowEngine(PyRunner):
                    f"the explicit coupling may blow up (thesis 4.20-4.22)")
         if self.strict_time_step:
             raise ValueError(message)
-        if "dt" not in self._warned:
-            self._warned.add("dt")
+        if not self._dt_unsafe:  # warn on becoming unsafe, not at every step while it stays so
+            object.__setattr__(self, "_dt_unsafe", True)
             warnings.warn(message, TimeStepWarning, stacklevel=2)
 
     def emulateAction(self):

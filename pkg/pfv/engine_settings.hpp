@@ -22,7 +22,7 @@ struct EngineSettings {
   // double from the previous pressures (refinement.hpp) until the estimated error is below
   // refinement_tolerance * max|p|. Falls back to the double factor if G is too
   // ill-conditioned for float.
-  bool mixed_precision = true;
+  bool mixed_precision = false;
   double refinement_tolerance = 1e-10;
   int max_refinement_passes = 8;
   int mesh_update_interval = 1000;

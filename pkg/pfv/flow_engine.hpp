@@ -53,7 +53,8 @@ class FlowEngine {
   // mark spheres that do not move. Collective modes (groups of spheres squeezing shared
   // pores) make this smaller than the thesis' single-particle dt_MV. Needs a mesh.
   // mode: if given with one entry per sphere (not all zero), the iteration starts from it
-  // (warm start from the previous mesh's mode); on return it holds the last iterate.
+  // (warm start from the previous mesh's mode, stopping early once the estimate changes by less
+  // than 0.5 % between iterations); on return it holds the last iterate.
   double viscous_stability_limit(const std::vector<double>& mass, int iterations,
                                  std::vector<Vec3>* mode = nullptr) const;
 

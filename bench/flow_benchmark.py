@@ -43,6 +43,7 @@ the raw per-trial data as JSON (--json, default /tmp/bench/flow_benchmark.json).
 """
 import datetime
 import gc
+import ast
 import json
 import math
 import os
@@ -324,6 +325,11 @@ def make_engine(kind, oedometer=False, oedo_interval=200):
     flow.permeabilityFactor = 1.0
     flow.useSolver = 3
     flow.slipBoundary = False  # YADE's slip factor on wall throats is a known model difference (-15 % flux)
+    if kind == 'pfv':
+        # PFV options under test, e.g. PFV_BENCH_SET="mixed_precision=True" (inherited by the children).
+        for item in filter(None, os.environ.get('PFV_BENCH_SET', '').split(',')):
+            name, value = item.split('=', 1)
+            setattr(flow, name.strip(), ast.literal_eval(value.strip()))
     return flow
 
 

@@ -15,16 +15,11 @@ worse on the same sample, see doc/validation.md), and far from what a broken cou
 Error figures are taken once the load has crossed the sample twice at the oedometric wave speed (Terzaghi's theory
 is quasi-static; the example prints and plots the earlier samples too).
 """
-import json
-import math
 import os
-import shutil
-import subprocess
 import sys
-import tempfile
 
-HERE = os.path.dirname(os.path.abspath(sys.argv[0]))
-EXAMPLE = os.path.normpath(os.path.join(HERE, '..', '..', 'examples', 'oedometer.py'))
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
+from oedometer_check import run_and_check  # noqa: E402
 
 # name, value in summary.json, lower bound, upper bound
 THRESHOLDS = [
@@ -38,35 +33,9 @@ THRESHOLDS = [
 ]
 
 
-def main():
-    out = tempfile.mkdtemp(prefix='pfv-oedometer-quick-')
-    yade = shutil.which('yade-double') or '/usr/bin/yade-double'
-    cmd = [yade, '-n', '-x', EXAMPLE, '--quick', '--engine=pfv', '--out=' + out]
-    print('running: ' + ' '.join(cmd), flush=True)
-    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    lines = [l for l in proc.stdout.splitlines() if l.startswith('oedometer:')]
-    print('\n'.join(lines))
-    path = os.path.join(out, 'summary.json')
-    if proc.returncode != 0 or not os.path.exists(path):
-        print(proc.stdout[-3000:])
-        print('FAIL the example did not complete (exit code %d)' % proc.returncode)
-        return 1
-    with open(path) as f:
-        s = json.load(f)
-    failures = 0
-    for name, key, lo, hi in THRESHOLDS:
-        v = s[key]
-        ok = math.isfinite(v) and lo <= v <= hi
-        failures += not ok
-        print('%s %s = %.4f (allowed %g .. %g)' % ('ok  ' if ok else 'FAIL', name, v, lo, hi))
+def permeameter(s):
     ok = s['Cv'] > 0 and s['K'] > 0 and abs(abs(s['Qin']) / abs(s['Qout']) - 1) < 1e-6
-    failures += not ok
-    print('%s permeameter: K = %.4g m/s, |Qin| = |Qout| (%.6g, %.6g)' % ('ok  ' if ok else 'FAIL', s['K'], s['Qin'],
-                                                                         s['Qout']))
-    print('%d failed; outputs in %s' % (failures, out))
-    if not failures:
-        shutil.rmtree(out, ignore_errors=True)
-    return 1 if failures else 0
+    return [(ok, 'permeameter: K = %.4g m/s, |Qin| = |Qout| (%.6g, %.6g)' % (s['K'], s['Qin'], s['Qout']))]
 
 
-sys.exit(main())
+sys.exit(run_and_check(['--quick', '--engine=pfv'], THRESHOLDS, permeameter))

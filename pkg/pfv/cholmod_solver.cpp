@@ -188,7 +188,7 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
 void CholmodSolver::promote_to_double(const PressureSystem& s) {
   if (!factor_ || !single_precision()) return;
   values32_ = nullptr;
-  numeric_factorization(s);  // overwrites the rounded values in place  // on the symbolic factor kept from the analysis
+  numeric_factorization(s);  // on the symbolic factor kept from the analysis; overwrites the rounded values
   plan_substitution();
 }
 

@@ -23,15 +23,11 @@ CellOrdering::CellOrdering(const Mesh& mesh, const PressureSystem& s, const int*
 }
 
 int CellOrdering::common_ancestor(int a, int b) const {
+  if (tree_.chain_end.empty()) return b;  // no tree (simplicial factor): follow the latest
   // Subtrees are ranges ending at their root (postorder), so the ancestor of a that contains
   // b is the first one at or beyond b.
   while (a >= 0 && tree_.chain_end[a] < b) a = tree_.parent[tree_.chain_end[a]];  // up one supernode
   return a < 0 ? n_ : std::max(a, b);  // different roots: last
-}
-
-int CellOrdering::place(const int* r, int count) const {
-  if (tree_.chain_end.empty()) return r[count - 1];  // no tree (simplicial factor): the latest
-  return common_ancestor(r[0], r[count - 1]);
 }
 
 std::vector<int> CellOrdering::carry_over(const Mesh& mesh, const PressureSystem& s) const {
@@ -57,12 +53,14 @@ std::vector<int> CellOrdering::carry_over(const Mesh& mesh, const PressureSystem
     std::vector<std::pair<int, int>> resolved;
     std::vector<int> still;
     for (int c : fresh) {
-      int r[4], count = 0;
+      int lo = n_, hi = kUnknown;  // over the neighbours placed in the old tree
       for (int nb : mesh.cell_neighbours[c])
-        if (nb >= 0 && position[nb] != kUnknown && position[nb] < n_) r[count++] = position[nb];
-      std::sort(r, r + count);
-      if (count > 0)
-        resolved.emplace_back(c, place(r, count));
+        if (nb >= 0 && position[nb] != kUnknown && position[nb] < n_) {
+          lo = std::min(lo, position[nb]);
+          hi = std::max(hi, position[nb]);
+        }
+      if (hi != kUnknown)
+        resolved.emplace_back(c, common_ancestor(lo, hi));
       else
         still.push_back(c);
     }

@@ -50,10 +50,8 @@ class CellOrdering {
   };
   static std::array<int, 4> key_of(const std::array<int, 4>& vertices);
 
-  // The lowest common ancestor of positions a < b in the old tree (n_ if none).
+  // The lowest common ancestor of positions a <= b in the old tree (n_ if none).
   int common_ancestor(int a, int b) const;
-  // Where a new cell with surviving neighbours at these positions goes (sorted, not empty).
-  int place(const int* positions, int count) const;
 
   int n_spheres_ = -1, n_ = 0;
   SupernodalChains tree_;

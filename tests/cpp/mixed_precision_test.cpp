@@ -41,6 +41,15 @@ PressureSystem graded_chain(int n, double decades, double scale = 1) {
   return s;
 }
 
+// G^-1 b with CHOLMOD's double factor: the reference.
+std::vector<double> double_solve(const PressureSystem& s, const std::vector<double>& b) {
+  CholmodSolver exact;
+  exact.factorize(s, Ordering::kAmd);
+  std::vector<double> x;
+  exact.solve(b, x);
+  return x;
+}
+
 }  // namespace
 
 TEST(MixedPrecision, MatchesTheDoubleSolveOverMovingSteps) {
@@ -74,11 +83,10 @@ TEST(MixedPrecision, LongChainConvergesDespiteItsConditionNumber) {
   // M-matrix) whose rounded factor stays a componentwise-small perturbation: refinement still
   // contracts. The conductance matrices of the pore network are all of this kind.
   const PressureSystem s = graded_chain(20000, 0);
-  std::vector<double> b(s.n_unknowns(), 0.0), x_exact, x;
+  std::vector<double> b(s.n_unknowns(), 0.0), x;
   b.back() = 1e-10;  // a flux injected at the closed end
-  CholmodSolver exact, single;
-  exact.factorize(s, Ordering::kAmd);
-  exact.solve(b, x_exact);
+  const std::vector<double> x_exact = double_solve(s, b);
+  CholmodSolver single;
   single.factorize(s, Ordering::kAmd, FactorPrecision::kSingle);
   ASSERT_TRUE(single.single_precision());
   Refinement r;
@@ -114,16 +122,14 @@ TEST(MixedPrecision, IllConditionedDenseSystemIsDetectedAndSolvedInDouble) {
     }
     s.col_start.push_back(static_cast<int>(s.row.size()));
   }
-  std::vector<double> b(n), x(n, 0.0), x_exact;
+  std::vector<double> b(n), x(n, 0.0);
   for (int i = 0; i < n; ++i) b[i] = std::sin(1.0 + i);
-  CholmodSolver exact, single;
-  exact.factorize(s, Ordering::kAmd);
-  exact.solve(b, x_exact);
+  const std::vector<double> x_exact = double_solve(s, b);
+  CholmodSolver single;
   single.factorize(s, Ordering::kAmd, FactorPrecision::kSingle);
   ASSERT_TRUE(single.single_precision());
   Refinement r;
-  const bool ok = r.solve(s, single, b, x, 1e-10, 8);
-  EXPECT_FALSE(ok);
+  EXPECT_FALSE(r.solve(s, single, b, x, 1e-10, 8));
   single.promote_to_double(s);
   EXPECT_FALSE(single.single_precision());
   single.solve(b, x);
@@ -132,11 +138,10 @@ TEST(MixedPrecision, IllConditionedDenseSystemIsDetectedAndSolvedInDouble) {
 
 TEST(MixedPrecision, WellConditionedChainConvergesFromAColdStart) {
   const PressureSystem s = graded_chain(50, 1);  // cond ~ 1e4
-  std::vector<double> b(s.n_unknowns()), x_exact, x(s.n_unknowns(), 0.0), r;
+  std::vector<double> b(s.n_unknowns()), x(s.n_unknowns(), 0.0), r;
   for (std::size_t i = 0; i < b.size(); ++i) b[i] = std::cos(0.1 * i);
-  CholmodSolver exact, single;
-  exact.factorize(s, Ordering::kAmd);
-  exact.solve(b, x_exact);
+  const std::vector<double> x_exact = double_solve(s, b);
+  CholmodSolver single;
   single.factorize(s, Ordering::kAmd, FactorPrecision::kSingle);
   Refinement refine;
   ASSERT_TRUE(refine.solve(s, single, b, x, 1e-12, 8));

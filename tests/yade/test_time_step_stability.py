@@ -55,33 +55,31 @@ _relaxed = []
 COMPACTION = 0.99  # scale factor of the positions (walls included) about the centre of the box
 
 
+def relax_and_save(name, what):
+    """1000 damped steps without fluid, then at rest, saved as O.saveTmp(name)."""
+    newton = [e for e in O.engines if isinstance(e, NewtonIntegrator)][0]
+    newton.damping = 0.5
+    O.run(1000, True)
+    print("     %s relaxed without fluid: unbalanced force %.2g" % (what, utils.unbalancedForce()))
+    newton.damping = 0.0
+    for b in O.bodies:
+        b.state.vel = Vector3(0, 0, 0)
+        b.state.angVel = Vector3(0, 0, 0)
+    O.saveTmp(name)
+
+
 def build():
     """The packing relaxed once without fluid (a rebuilt packing starts with unbalanced contact forces that would
     keep feeding kinetic energy), then the flow engine and the random velocities."""
     if not _relaxed:
         scenes.build_permeameter(num=1000, frozen=False)
-        newton = [e for e in O.engines if isinstance(e, NewtonIntegrator)][0]
-        newton.damping = 0.5
         O.dt = 0.8 * utils.PWaveTimeStep()
-        O.run(1000, True)
-        print("     packing relaxed without fluid: unbalanced force %.2g" % utils.unbalancedForce())
-        newton.damping = 0.0
-        for b in O.bodies:
-            b.state.vel = Vector3(0, 0, 0)
-            b.state.angVel = Vector3(0, 0, 0)
-        O.saveTmp("relaxed")
+        relax_and_save("relaxed", "packing")
         # The same packing compacted: positions (walls included) scaled about the centre, relaxed again.
         centre = Vector3(0.5, 0.5, 0.5)
         for b in O.bodies:
             b.state.pos = centre + (b.state.pos - centre) * COMPACTION
-        newton.damping = 0.5
-        O.run(1000, True)
-        print("     compacted packing relaxed without fluid: unbalanced force %.2g" % utils.unbalancedForce())
-        newton.damping = 0.0
-        for b in O.bodies:
-            b.state.vel = Vector3(0, 0, 0)
-            b.state.angVel = Vector3(0, 0, 0)
-        O.saveTmp("compacted")
+        relax_and_save("compacted", "compacted packing")
         _relaxed.append(True)
     O.loadTmp("relaxed")
     flow = FlowEngine(label="flow")

@@ -351,8 +351,9 @@ class FlowEngine(PyRunner):
         core = self._core
         if not core.has_mesh():
             return float("inf")
-        # The shear term adds damping to the operator, so switching it recomputes the limit too.
-        key = (core.viscosity, core.viscous_shear and core.shear_forces().size > 0)
+        # The shear term adds damping to the operator, so switching it recomputes the limit too
+        # (switched on, its pairs arrive with a remesh, which recomputes again).
+        key = (core.viscosity, core.viscous_shear)
         if self._collective_mesh != core.remesh_count or self._collective_viscosity != key:
             mode = self._collective_mode
             warm = mode is not None and len(mode) == len(self._masses) and self._dt_collective is not None

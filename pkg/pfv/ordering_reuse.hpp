@@ -8,9 +8,10 @@
 // eliminated right after the lowest common ancestor, in the old elimination tree, of its
 // surviving neighbours, as if it had been in the separator that splits them. Measured at
 // 10 000 spheres moved at random by 0.5 % of a radius (0.8 % new cells): 3 % more fill than a
-// fresh METIS ordering, for 1/20 of the analysis time. Following the latest neighbour instead
+// fresh METIS ordering, for 1/20 of the analysis time (bench/solver_stages.py). Rejected during
+// development (scratch measurements at 10 000 spheres): following the latest neighbour, which
 // couples subtrees when a flip straddles a separator (2.8x the fill at 2 % of a radius), and
-// placing a new cell as low as the tree allows gave 20 % more fill. The caller checks the fill of the
+// placing a new cell as low as the tree allows (20 % more fill at 0.5 %). The caller checks the fill of the
 // result against the fill of the last fresh ordering and orders afresh when it has drifted
 // (cholmod_solver.hpp: GivenOrdering::max_fill).
 #pragma once

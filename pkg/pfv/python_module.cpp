@@ -109,8 +109,7 @@ PYBIND11_MODULE(_core, m) {
 
   // One axis of the sphere centres straight from YADE's coordinate list for that axis
   // (yade._utils.coordsAndDisplacements(axis)[0], all bodies): no numpy round trip. One axis at
-  // a time, so that each list can be dropped before the next is made (three 50 000-float
-  // lists alive at once make YADE's calls 2x slower: fresh memory instead of reused).
+  // a time, so that only one list is alive at once.
   m.def("gather_axis", [](const py::list& coords, const py::array_t<long long>& rows, Array& out, int axis) {
     const auto r = rows.unchecked<1>();
     if (axis < 0 || axis > 2 || out.ndim() != 2 || out.shape(1) != 3 || out.shape(0) != r.shape(0))

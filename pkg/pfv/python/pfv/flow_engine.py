@@ -293,7 +293,7 @@ class FlowEngine(PyRunner):
             for w in (2 * axis, 2 * axis + 1):
                 if not self._boundary_use_max_min[w]:
                     walls[w] = coords[self._wall_rows[w]] + self._wall_half[w]
-            del coords  # before the next axis' list is made: YADE then reuses its memory
+            del coords  # one list alive at a time
         for w in range(6):
             if self._boundary_use_max_min[w]:
                 axis = w // 2

@@ -1,0 +1,151 @@
+"""Stage measurements behind doc/benchmarks.md ("What each optimisation gained", this session's table) and
+doc/model.md ("Solving G p = b"), on the cached benchmark packing (made by bench/flow_benchmark.py).
+
+    yade-double -j1 -n -x bench/solver_stages.py [--size=10000]
+
+1. ordering reuse: CHOLMOD analysis with a fresh METIS ordering and with the ordering carried over from the previous
+   mesh, for the same positions and after moving every sphere at random by 0.5 % and 2 % of the mean radius
+   (fill per unknown, kept or not, share of new cells);
+2. mixed precision: solve time of the double and of the refined single-precision factor in a loop (the factor
+   stays in cache), refinement passes, contraction estimate, largest pressure difference / max|p|;
+3. force write to YADE: the engine's bridge (Vector3 written in place) against addF with tuples from Python;
+4. positions read: coordsAndDisplacements for the three axes with the lists alive together, and one at a time.
+Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers).
+"""
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
+import flow_benchmark as fb  # noqa: E402  (packing cache)
+
+import pfv  # noqa: E402
+import yade  # noqa: E402
+from yade import O, utils  # noqa: E402
+from yade.minieigenHP import Vector3  # noqa: E402
+
+
+def option(name, default):
+    for a in sys.argv[1:]:
+        if a.startswith('--%s=' % name):
+            return type(default)(a.split('=', 1)[1])
+    return default
+
+
+def stats(times):
+    return 'min %.2f ms, median %.2f ms' % (1e3 * min(times), 1e3 * float(np.median(times)))
+
+
+def engine(mixed=False, reuse=True):
+    e = pfv.Engine()
+    e.bnd_is_pressure = [False, False, True, True, False, False]
+    e.bnd_value = [0, 0, 100.0, 0, 0, 0]
+    e.viscosity = 1e-3
+    e.slip_boundary = False
+    e.mesh_update_interval = 10 ** 9
+    e.mixed_precision = mixed
+    e.reuse_ordering = reuse
+    return e
+
+
+def ordering(pos, rad, walls):
+    print('1. ordering reuse')
+    rng = np.random.default_rng(1)
+    for amplitude in (0.0, 0.005, 0.02):
+        fresh, reused = engine(reuse=False), engine()
+        reused.step(pos, rad, walls, 1e-4)
+        moved = pos + rng.normal(0, amplitude * rad.mean(), pos.shape)
+        for e in (fresh, reused):
+            e.request_remesh()
+            e.step(moved, rad, walls, 1e-4)
+        old = set(tuple(sorted(c)) for c in np.asarray(engine_cells(pos, rad, walls)).tolist())
+        new = [tuple(sorted(c)) for c in np.asarray(reused.cell_vertices()).tolist()]
+        share_new = sum(c not in old for c in new) / len(new)
+        print('   moved by %.1f %% of a radius (%.1f %% new cells): fresh analysis %.3f s, fill %.1f; carried over: '
+              'analysis %.3f s, fill %.1f, kept %s'
+              % (100 * amplitude, 100 * share_new, fresh.remesh_times()['analysis'], fresh.factor_fill(),
+                 reused.remesh_times()['analysis'], reused.factor_fill(), reused.ordering_reused()))
+
+
+def engine_cells(pos, rad, walls):
+    e = engine()
+    e.step(pos, rad, walls, 1e-4)
+    return e.cell_vertices()
+
+
+def mixed_precision(pos, rad, walls):
+    print('2. mixed precision (loop without DEM: the factor stays in cache)')
+    rng = np.random.default_rng(2)
+    vel = rng.normal(0, 1e-3, pos.shape)
+    result = {}
+    for mixed in (False, True):
+        e, p, times, pressures = engine(mixed=mixed), pos.copy(), [], []
+        for i in range(30):
+            p = p + vel * 1e-4
+            e.step(p, rad, walls, 1e-4)
+            times.append(e.step_times()['solve'])
+            pressures.append(e.pressure())
+        result[mixed] = pressures
+        print('   %s: solve %s (steps 4-30), passes at the last step %d, contraction %.2g'
+              % ('mixed ' if mixed else 'double', stats(times[3:]), e.gs_iterations, e.refinement_contraction()))
+    diff = max(np.abs(a - b).max() / np.abs(b).max() for a, b in zip(result[True], result[False]))
+    print('   largest |p_mixed - p_double| / max|p| over the 30 steps: %.2g' % diff)
+
+
+def exchange(pos, rad, L):
+    O.reset()
+    O.bodies.append(utils.aabbWalls([(0, 0, 0), (L, L, L)], thickness=0))
+    for x, r in zip(pos, rad):
+        O.bodies.append(utils.sphere(tuple(x), r))
+    n = len(O.bodies)
+    print('3. force write to YADE, %d bodies' % n)
+    ids = np.arange(n, dtype=np.int64)
+    forces = np.random.default_rng(3).normal(size=(n, 3))
+    bridge = pfv._core.YadeForceBridge(Vector3, ids, ids)
+    add = O.forces.addF
+    tuples = [tuple(f) for f in forces.tolist()]
+    t_bridge, t_tuples = [], []
+    for k in range(20):
+        t0 = time.perf_counter()
+        bridge.apply(add, forces)
+        t_bridge.append(time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        for i in range(n):
+            add(i, tuples[i])
+        t_tuples.append(time.perf_counter() - t0)
+    print('   bridge (in place: %s): %s; addF with tuples from Python: %s'
+          % (bridge.writes_in_place, stats(t_bridge), stats(t_tuples)))
+    print('4. positions read, %d bodies' % n)
+    read = yade._utils.coordsAndDisplacements
+    together, apart = [], []
+    for k in range(10):
+        t0 = time.perf_counter()
+        lists = [read(axis)[0] for axis in range(3)]
+        together.append(time.perf_counter() - t0)
+        del lists
+        t0 = time.perf_counter()
+        for axis in range(3):
+            c = read(axis)[0]
+            del c
+        apart.append(time.perf_counter() - t0)
+    print('   three lists alive together: %s; one axis at a time: %s' % (stats(together), stats(apart)))
+
+
+def main():
+    n = option('size', 10000)
+    spheres, meta = fb.read_packing(n)
+    a = np.array(spheres, dtype=float)
+    pos, rad = a[:, :3].copy(), a[:, 3].copy()
+    L = meta.get('box', fb.box_side(n))
+    walls = [0, L, 0, L, 0, L]
+    print('solver_stages: N = %d, packing %s' % (n, fb.packing_path(n)))
+    ordering(pos, rad, walls)
+    mixed_precision(pos, rad, walls)
+    exchange(pos, rad, L)
+    return 0
+
+
+if __name__ == '__main__' and 'yade' in sys.modules:
+    sys.exit(main())

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "pressure_system.hpp"
+#include "serial_openmp.hpp"
 
 namespace pfv {
 
@@ -172,7 +173,10 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
   auto* f = static_cast<cholmod_factor*>(factor_);
   const int n = s.n_unknowns();
   cholmod_sparse a = view_of(s);
-  cholmod_factorize(&a, f, c);
+  {
+    const SerialOpenMpRegions serial;
+    cholmod_factorize(&a, f, c);
+  }
   if (c->status == CHOLMOD_NOT_POSDEF || f->minor < static_cast<size_t>(n)) {
     const auto minor = f->minor;
     release();

@@ -4,7 +4,7 @@ Run with YADE (the driver re-invokes yade-double on this file for every measurem
 
     yade-double -n -x bench/flow_benchmark.py [--quick] [--sizes=1000,10000,50000] [--rounds=3]
                 [--threads=1,2] [--out=doc/benchmarks.md] [--json=FILE] [--no-memory] [--no-oedometer]
-                [--oedo-sizes=1000,10000] [--oedo-steps=600] [--oedo-interval=200] [--steady=20]
+                [--no-multithread] [--oedo-sizes=1000,10000] [--oedo-steps=600] [--oedo-interval=200] [--steady=20]
                 [--gen-threads=T]    (threads of the child that generates a missing packing; default max of --threads)
 
 --quick: 300 spheres, 1 round, -j1, 10 steady steps, oedometer 60 steps with a remesh every 20, report written to
@@ -28,7 +28,8 @@ What it does
   4. Oedometer (coupled/dry cost ratio): the packing with the top wall under a TriaxialStressController (stressMask=2,
      load step 10 -> 11 kPa), drained top, impermeable other walls, viscosity 10, meshUpdateInterval=200,
      defTolerance=0.3, O.dt=1e-4 (as in YADE's examples/FluidCouplingPFV/oedometer.py), O.run(M) timed for YADE,
-     PFV and dry, interleaved like the trials.
+     PFV and dry, interleaved like the trials; and (unless --no-multithread) both engines again with
+     multithread=True, the remesh built in a background thread while the DEM runs (PFV's background_remesh).
   Children run with OPENBLAS_NUM_THREADS = OMP_NUM_THREADS = T (Debian's OpenBLAS would use every core otherwise).
 
 Definitions (medians over rounds of per-trial medians)
@@ -101,6 +102,7 @@ def parse_args(argv):
         json=None,
         memory=True,
         oedometer=True,
+        multithread=True,
         oedo_sizes=None,
         oedo_steps=60 if quick else 600,
         oedo_interval=20 if quick else 200,
@@ -119,6 +121,9 @@ def parse_args(argv):
             continue
         if a == '--no-oedometer':
             opts['oedometer'] = False
+            continue
+        if a == '--no-multithread':
+            opts['multithread'] = False
             continue
         if not a.startswith('--') or '=' not in a:
             raise SystemExit('flow_benchmark: unknown argument %r (see the docstring)' % a)
@@ -530,19 +535,27 @@ def oedometer_trial(kind, n, steps, interval):
     triax.goal2 = OEDO_LOAD
     flow = None
     if kind != 'dry':
-        flow = make_engine(kind, oedometer=True, oedo_interval=interval)
+        engine, _, variant = kind.partition('-')
+        flow = make_engine(engine, oedometer=True, oedo_interval=interval)
         insert_engine(flow)
     O.timingEnabled = True
     gc.collect()
     y0 = O.bodies[3].state.pos[1]
     t0 = time.perf_counter()
-    O.run(steps, True)
+    if kind.endswith('-mt'):
+        # Remesh in a background thread while the DEM runs, switched on after the first step: YADE 2023.02a
+        # segfaults when multithread=True before its first triangulation. The first mesh is foreground in both.
+        O.run(1, True)
+        flow.multithread = True
+        O.run(steps - 1, True)
+    else:
+        O.run(steps, True)
     wall = time.perf_counter() - t0
     res = dict(kind=kind, seconds=wall, steps=steps, settlement=y0 - O.bodies[3].state.pos[1])
     if flow is not None:
         res['exec'] = flow.execTime * 1e-9
         res['p_mid'] = flow.getPorePressure((0.5 * O.bodies[1].state.pos[0], 0.1 * y0, 0.5 * O.bodies[5].state.pos[2]))
-        if kind == 'pfv':
+        if kind.startswith('pfv'):
             res['remeshes'] = flow.core.remesh_count
     del flow
     O.reset()
@@ -578,10 +591,10 @@ def timing_child(opts):
             build_scene(n, oedometer=True)
             O.saveTmp('oedo')
             log('oedometer n=%d threads=%d: %d steps per trial' % (n, O.numThreads, opts['oedo_steps']))
-            trials = dict(yade=[], pfv=[], dry=[])
-            order = ['yade', 'pfv', 'dry']
+            order = ['yade', 'pfv', 'dry'] + (['yade-mt', 'pfv-mt'] if opts['multithread'] else [])
+            trials = {kind: [] for kind in order}
             for r in range(rounds):
-                k = r % 3
+                k = r % len(order)
                 for kind in order[k:] + order[:k]:
                     res = oedometer_trial(kind, n, opts['oedo_steps'], opts['oedo_interval'])
                     trials[kind].append(res)
@@ -803,7 +816,7 @@ def summarise(timing, memory):
             tr = od['trials']
             dry = median([x['seconds'] / x['steps'] for x in tr['dry']])
             r = dict(n=int(ns), steps=od['steps'], interval=od['interval'], dry=dry)
-            for kind in ('yade', 'pfv'):
+            for kind in [k for k in ('yade', 'pfv', 'yade-mt', 'pfv-mt') if tr.get(k)]:
                 c = median([x['seconds'] / x['steps'] for x in tr[kind]])
                 r[kind] = dict(coupled=c, ratio=c / dry if dry else float('nan'),
                                exec=median([x['exec'] / x['steps'] for x in tr[kind]]),
@@ -1087,6 +1100,29 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
                      r['pfv']['p_mid'] or 0, r['dry_settlement'] or 0, r['yade']['settlement'] or 0,
                      r['pfv']['settlement'] or 0))
         w('')
+        if any(r.get('pfv-mt') for t in summ for r in summ[t]['oedometer'].values()):
+            w('Background remesh (`multithread=True` in both engines: the next mesh and factor are built in a second '
+              'thread while the DEM runs on the current one, and adopted when ready, so a few steps after each remesh '
+              'use a mesh built from slightly older positions; the accuracy cost is measured as the change of the '
+              'pressure probe and of the settlement against the same engine without it):')
+            w('')
+            w('| threads | N | YADE mt coupled | YADE mt coupled/dry | PFV mt coupled | PFV mt coupled/dry | mt/foreground YADE '
+              '| mt/foreground PFV | p(0.1 H) change YADE / PFV | settlement change YADE / PFV |')
+            w('|---|---|---|---|---|---|---|---|---|---|')
+
+            def change(r, kind, key):
+                a, b = r[kind + '-mt'].get(key), r[kind].get(key)
+                return '%.2g %%' % (100 * (a - b) / abs(b)) if a is not None and b else 'n/a'
+            for t in sorted(summ, key=int):
+                for ns, r in sorted(summ[t]['oedometer'].items(), key=lambda kv: int(kv[0])):
+                    if not r.get('pfv-mt'):
+                        continue
+                    w('| %s | %s | %s | **%.2f** | %s | **%.2f** | %.2f | %.2f | %s / %s | %s / %s |'
+                      % (t, ns, fmt_t(r['yade-mt']['coupled']), r['yade-mt']['ratio'], fmt_t(r['pfv-mt']['coupled']),
+                         r['pfv-mt']['ratio'], r['yade-mt']['coupled'] / r['yade']['coupled'],
+                         r['pfv-mt']['coupled'] / r['pfv']['coupled'], change(r, 'yade', 'p_mid'),
+                         change(r, 'pfv', 'p_mid'), change(r, 'yade', 'settlement'), change(r, 'pfv', 'settlement')))
+            w('')
     w('Amortised coupled/dry ratio of the permeameter for a remesh every R steps, (dry + flow + remesh/R) / dry:')
     w('')
     w('| threads | N | YADE R=200 | PFV R=200 | YADE R=1000 | PFV R=1000 |')
@@ -1145,6 +1181,8 @@ def driver(opts, argv):
                   '--oedo-steps=%d' % opts['oedo_steps'], '--oedo-interval=%d' % opts['oedo_interval']]
     if not opts['oedometer']:
         child_opts.append('--no-oedometer')
+    if not opts['multithread']:
+        child_opts.append('--no-multithread')
     if opts['quick']:
         child_opts.append('--quick')
     timing = {}

@@ -9,7 +9,11 @@ doc/model.md ("Solving G p = b"), on the cached benchmark packing (made by bench
 2. mixed precision: solve time of the double and of the refined single-precision factor in a loop (the factor
    stays in cache), refinement passes, contraction estimate, largest pressure difference / max|p|;
 3. force write to YADE: the engine's bridge (Vector3 written in place) against addF with tuples from Python;
-4. positions read: coordsAndDisplacements for the three axes with the lists alive together, and one at a time.
+4. positions read: coordsAndDisplacements for the three axes with the lists alive together, and one at a time;
+5. successive forced remeshes of one pfv.FlowEngine on the settled permeameter scene of bench/flow_benchmark.py (the
+   benchmark's "remesh" is the second mesh of an engine): C++ stage times per remesh, and the factorisation with
+   CHOLMOD's own OpenMP teams (4 threads, its compiled-in CHOLMOD_OMP_NUM_THREADS) against the engine's default, which
+   runs them on the calling thread (`flow.core.cholmod_openmp_teams`).
 Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers).
 """
 import os
@@ -133,6 +137,26 @@ def exchange(pos, rad, L):
     print('   three lists alive together: %s; one axis at a time: %s' % (stats(together), stats(apart)))
 
 
+def remesh_sequence(n):
+    print('5. successive forced remeshes, pfv.FlowEngine in the DEM scene')
+    fb.build_scene(n)
+    flow = fb.make_engine('pfv')
+    fb.insert_engine(flow)
+    for _ in range(3):
+        O.step()
+    core = flow.core
+    keys = ('triangulation', 'geometry', 'conductance', 'factorization', 'force_cache')
+    for serial in (True, True, True, False, True):
+        core.cholmod_openmp_teams = not serial
+        flow.updateTriangulation = True
+        O.step()
+        t = core.remesh_times()
+        print('   mesh %d, CHOLMOD OpenMP regions %s: %s' % (
+            core.remesh_count, 'on the calling thread' if serial else 'in CHOLMOD teams of 4',
+            ', '.join('%s %.1f ms' % (k, 1e3 * t[k]) for k in keys)))
+    O.engines = O.engines[:1]
+
+
 def main():
     n = option('size', 10000)
     spheres, meta = fb.read_packing(n)
@@ -144,6 +168,7 @@ def main():
     ordering(pos, rad, walls)
     mixed_precision(pos, rad, walls)
     exchange(pos, rad, L)
+    remesh_sequence(n)
     return 0
 
 

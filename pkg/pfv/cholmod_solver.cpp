@@ -173,7 +173,9 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
   auto* f = static_cast<cholmod_factor*>(factor_);
   const int n = s.n_unknowns();
   cholmod_sparse a = view_of(s);
-  {
+  if (openmp_teams_) {
+    cholmod_factorize(&a, f, c);
+  } else {
     const SerialOpenMpRegions serial;
     cholmod_factorize(&a, f, c);
   }

@@ -54,6 +54,8 @@ class CholmodSolver {
   // (parallel_substitution.hpp); with one, CHOLMOD's own (BLAS-based) solve is used in double
   // and the same subtree plan, run serially, in single precision.
   void solve(const std::vector<double>& rhs, std::vector<double>& x);
+  // See EngineSettings::cholmod_openmp_teams; applies to the factorisations that follow.
+  void set_openmp_teams(bool on) { openmp_teams_ = on; }
   void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
   bool single_precision() const { return values32_ != nullptr; }
   double parallel_top_fraction() const { return parallel_.top_fraction(); }
@@ -73,6 +75,7 @@ class CholmodSolver {
   void plan_substitution();
   struct Common;
   Common* common_;
+  bool openmp_teams_ = false;
   void* factor_ = nullptr;  // cholmod_factor*
   void* rhs_ = nullptr;     // cholmod_dense*, reused
   void* x_ = nullptr;

@@ -25,6 +25,10 @@ struct EngineSettings {
   bool mixed_precision = false;
   double refinement_tolerance = 1e-10;
   int max_refinement_passes = 8;
+  // Let CHOLMOD fork the OpenMP teams of its numeric factorisation (4 threads, compiled in)
+  // instead of running them on the calling thread (serial_openmp.hpp); kept to measure the
+  // difference (bench/solver_stages.py).
+  bool cholmod_openmp_teams = false;
   int mesh_update_interval = 1000;
   double def_tolerance = 0;  // YADE's default: no strain-triggered remesh
   double p_zero = 0;

@@ -87,6 +87,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       given.from_metis = previous->from_metis();
     }
     CholmodSolver& f = *l.cholmod;
+    f.set_openmp_teams(settings.cholmod_openmp_teams);
     f.factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering,
                 settings.mixed_precision ? FactorPrecision::kSingle : FactorPrecision::kDouble, given);
     if (f.ready() && f.permutation())

@@ -184,6 +184,8 @@ PYBIND11_MODULE(_core, m) {
                       if (!(v > 0 && v < 1)) throw py::value_error("refinement_tolerance must be in (0, 1)");
                       e.settings.refinement_tolerance = v;
                     })
+      .def_property("cholmod_openmp_teams", [](const FlowEngine& e) { return e.settings.cholmod_openmp_teams; },
+                    [](FlowEngine& e, bool v) { e.settings.cholmod_openmp_teams = v; })
       .def_property("reuse_ordering", [](const FlowEngine& e) { return e.settings.reuse_ordering; },
                     [](FlowEngine& e, bool v) { e.settings.reuse_ordering = v; })
       .def("ordering_reused", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().ordering_given(); })

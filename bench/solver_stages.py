@@ -13,7 +13,9 @@ doc/model.md ("Solving G p = b"), on the cached benchmark packing (made by bench
 5. successive forced remeshes of one pfv.FlowEngine on the settled permeameter scene of bench/flow_benchmark.py (the
    benchmark's "remesh" is the second mesh of an engine): C++ stage times per remesh, and the factorisation with
    CHOLMOD's own OpenMP teams (4 threads, its compiled-in CHOLMOD_OMP_NUM_THREADS) against the engine's default, which
-   runs them on the calling thread (`flow.core.cholmod_openmp_teams`).
+   runs them on the calling thread (`flow.core.cholmod_openmp_teams`);
+6. the collective viscous limit of a first mesh (drained top, viscosity 10, density 2600): the engine's Arnoldi
+   (at most 40 operator applications) against power iteration from the same fixed start, 40 and 120 iterations.
 Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers).
 """
 import os
@@ -157,6 +159,29 @@ def remesh_sequence(n):
     O.engines = O.engines[:1]
 
 
+def collective_limit(pos, rad, walls):
+    print('6. collective viscous limit, first mesh')
+    e = engine()
+    e.bnd_is_pressure = [False, False, False, True, False, False]
+    e.viscosity = 10.0
+    for _ in range(2):  # the operator is linearised about the previous step's positions
+        e.step(pos, rad, walls, 1e-4)
+    mass = 2600 * 4 / 3 * np.pi * rad ** 3
+    t0 = time.perf_counter()
+    arnoldi = e.viscous_stability_limit(mass, 40)
+    t_arnoldi = time.perf_counter() - t0
+    k = np.arange(len(rad))  # the engine's fixed start, continued 3 power iterations per call
+    mode = np.stack([np.sin(1.0 + 3.1 * k), np.cos(2.0 + 1.7 * k), np.sin(0.5 + 2.3 * k)], axis=1)
+    t0 = time.perf_counter()
+    power = []
+    for _ in range(40):
+        limit, mode = e.viscous_stability_mode(mass, 3, mode)
+        power.append(limit)
+    t_power = (time.perf_counter() - t0) / 3  # per 40 iterations
+    print('   Arnoldi %.7g s in %.3f s; power iteration: %.7g after 39 iterations (%.3f s), %.7g after 120; '
+          'power-39 / Arnoldi - 1 = %.2g' % (arnoldi, t_arnoldi, power[12], t_power, power[-1], power[12] / arnoldi - 1))
+
+
 def main():
     n = option('size', 10000)
     spheres, meta = fb.read_packing(n)
@@ -168,6 +193,7 @@ def main():
     ordering(pos, rad, walls)
     mixed_precision(pos, rad, walls)
     exchange(pos, rad, L)
+    collective_limit(pos, rad, walls)
     remesh_sequence(n)
     return 0
 

@@ -49,14 +49,21 @@ class FlowEngine {
 
   // Stability limit of the explicit coupling from the fluid alone: 2 / lambda_max of
   // M^-1 V, where V maps sphere velocities to fluid forces through the current mesh
-  // (dV/dt -> solve -> forces, plus the viscous shear term when on). Power iteration from the last step's positions; masses <= 0
-  // mark spheres that do not move. Collective modes (groups of spheres squeezing shared
-  // pores) make this smaller than the thesis' single-particle dt_MV. Needs a mesh.
-  // mode: if given with one entry per sphere (not all zero), the iteration starts from it
-  // (warm start from the previous mesh's mode, stopping early once the estimate changes by less
-  // than 0.5 % between iterations); on return it holds the last iterate.
+  // (dV/dt -> solve -> forces, plus the viscous shear term when on), linearised about the
+  // last step's positions; masses <= 0 mark spheres that do not move. Collective modes
+  // (groups of spheres squeezing shared pores) make this smaller than the thesis'
+  // single-particle dt_MV. Needs a mesh (viscous_stability.cpp).
+  // Without a mode: Arnoldi from a fixed start, at most 'iterations' operator applications,
+  // stopping once the largest Ritz value changes by less than 1e-6. mode: if given with one
+  // entry per sphere (not all zero), power iteration starts from it instead (warm start from
+  // the previous mesh's mode, stopping once the estimate changes by less than 0.5 %). On
+  // return mode holds the estimated eigenvector (unit norm).
   double viscous_stability_limit(const std::vector<double>& mass, int iterations,
                                  std::vector<Vec3>* mode = nullptr) const;
+  // accel = M^-1 F(v): the fluid forces of the sphere velocities v on the current mesh over
+  // the masses (zero for mass <= 0). The operator of viscous_stability_limit; public for tests.
+  void apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,
+                              std::vector<Vec3>& accel) const;
 
   // Results of the last step.
   const std::vector<Vec3>& forces() const { return force_; }  // spheres, then six walls

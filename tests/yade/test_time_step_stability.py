@@ -16,7 +16,7 @@ Checks
    naming the limit, O.iter does not advance, and nothing was warned.
 4. Control: O.dt = 0.25 dt_MV is stable (over 300 steps the kinetic energy never exceeds twice its initial value
    and ends below it), so the scene and the criterion are sound.
-5. After one coupled step the engine knows its collective viscous limit (power iteration on its linearised fluid
+5. After one coupled step the engine knows its collective viscous limit (Arnoldi on its linearised fluid
    operator, 2 / lambda_max of M^-1 V), which is below dt_MV on this dense packing (the thesis' 0.8 dt_MV blows up
    here within 20 steps). O.dt = time_step_safety * critical_time_step, the largest step the engine accepts silently,
    is stable by the same criterion, and no warning is given.
@@ -221,7 +221,7 @@ flow = build()
 O.dt = 1e-3 * flow.viscous_time_step
 O.step()
 dt_collective = flow.collective_viscous_time_step
-print("     collective viscous limit 2 / lambda_max(M^-1 V) = %.4g s = %.3f dt_MV (power iteration on the engine's "
+print("     collective viscous limit 2 / lambda_max(M^-1 V) = %.4g s = %.3f dt_MV (Arnoldi on the engine's "
       "linearised fluid operator; the thesis' single-particle dt_MV is not a safe bound for collective modes)"
       % (dt_collective, dt_collective / dt_mv))
 check(dt_collective < dt_mv, "the collective limit is below dt_MV on this dense packing")

@@ -113,7 +113,7 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_dt_dem", float("inf"))
         object.__setattr__(self, "_masses", None)
         # Collective viscous limit: computed on every new mesh (remesh_count changes) and when
-        # the viscosity changes; the power iteration of a remesh starts from the previous mesh's mode.
+        # the viscosity changes; a remesh's power iteration starts from the previous mesh's mode.
         object.__setattr__(self, "_dt_collective", None)
         object.__setattr__(self, "_collective_viscosity", None)
         object.__setattr__(self, "_collective_mesh", None)  # core.remesh_count it was computed on
@@ -344,10 +344,12 @@ class FlowEngine(PyRunner):
         """2 / lambda_max(M^-1 V) of the current mesh: the viscous limit of the explicit coupling
         for collective motions (groups of spheres squeezing shared pores), which the thesis'
         single-particle dt_MV overestimates (0.3-0.5 dt_MV measured on dense packings).
-        Computed by power iteration on every new mesh and when the viscosity changes:
-        collective_iterations (40) from a fixed start on the first mesh, collective_iterations_warm
-        (10) started from the previous mesh's mode afterwards (each iteration costs one
-        back-substitution and one force evaluation; see collective_viscous_history)."""
+        Computed on every new mesh and when the viscosity changes: on the first mesh by Arnoldi
+        from a fixed start (at most collective_iterations = 40 operator applications, stopping
+        once the estimate settles to 1e-6), afterwards by power iteration started from the
+        previous mesh's mode (at most collective_iterations_warm = 10). Each operator application
+        costs one back-substitution and one force evaluation; see collective_viscous_history
+        ("iterations" there is the cap, "seconds" the cost)."""
         core = self._core
         if not core.has_mesh():
             return float("inf")

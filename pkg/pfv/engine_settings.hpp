@@ -20,7 +20,7 @@ struct EngineSettings {
   double max_fill_growth = 1.1;
   // useSolver 3 only: keep the Cholesky factor in single precision and refine each solve in
   // double from the previous pressures (refinement.hpp) until the estimated error is below
-  // refinement_tolerance * max|p|. Falls back to the double factor if G is too
+  // refinement_tolerance * (max p - min p) over the unknowns. Falls back to the double factor if G is too
   // ill-conditioned for float.
   bool mixed_precision = false;
   double refinement_tolerance = 1e-10;

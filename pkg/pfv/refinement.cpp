@@ -71,12 +71,17 @@ bool Refinement::solve(const PressureSystem& s, CholmodSolver& m, const std::vec
     ++passes_;
     const double d = max_abs(correction_), scale = max_abs(x);
     if (d <= kRoundOff * scale) return true;
+    // The tolerance is relative to the spread of the pressures, not to their size: forces and
+    // fluxes depend on differences, and a large common offset (pZero, a deep hydrostatic
+    // level) would otherwise let the differences carry a large relative error.
+    const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+    const double spread = *hi - *lo > 0 ? *hi - *lo : scale;
     if (passes_ > 1 && previous > 1e3 * kRoundOff * scale) {
       rho_ = std::max(rho_, d / previous);  // a pass that contracted less than estimated
       if (rho_ >= 0.5) return false;
     }
     previous = d;
-    if (rho_ / (1 - rho_) * d <= tolerance * scale) return true;
+    if (rho_ / (1 - rho_) * d <= tolerance * spread) return true;
   }
   return false;
 }

@@ -8,7 +8,8 @@
 // while each pass reads half the bytes of a double substitution. rho is estimated once per
 // factor, before its first solve, by a few power iterations on I - M^-1 G (times a safety
 // factor: the power iteration approaches rho from below); a solve stops as soon as the
-// estimated error rho / (1 - rho) * |correction| is below the tolerance, relative to max |x|.
+// estimated error rho / (1 - rho) * |correction| is below the tolerance, relative to the spread
+// max x - min x of the solution (max |x| if it is uniform).
 // A pass that contracts less than rho raises it. (The ratio of the first two corrections is
 // no estimate: on an ill-conditioned G it can be tiny while the iteration diverges.)
 #pragma once

@@ -78,6 +78,33 @@ TEST(MixedPrecision, MatchesTheDoubleSolveOverMovingSteps) {
     EXPECT_LE((mixed.forces()[v] - exact.forces()[v]).norm(), 1e-8 * (exact.forces()[v].norm() + 1e-12));
 }
 
+TEST(MixedPrecision, ToleranceFollowsThePressureDifferencesNotTheirOffset) {
+  // 1 Pa across the sample on top of 1e5 Pa: the forces depend on the 1 Pa, so the refined
+  // pressures must match the double solve to the tolerance of the spread, not of 1e5.
+  const auto p = test::random_packing(600, 71, 0.02, 0.035);
+  FlowEngine exact = test::permeameter(1), mixed = test::permeameter(1);
+  for (FlowEngine* e : {&exact, &mixed}) {
+    e->bc.value[2] = 1e5 + 1;
+    e->bc.value[3] = 1e5;
+  }
+  exact.settings.mixed_precision = false;
+  mixed.settings.mixed_precision = true;
+  std::vector<Vec3> x = p.centre;
+  for (int step = 0; step < 3; ++step) {
+    for (std::size_t k = 0; k < x.size(); ++k) x[k].y() = 0.5 + (p.centre[k].y() - 0.5) * (1 - 1e-6 * step);
+    exact.step(x, p.radius, p.walls, 1e-3);
+    mixed.step(x, p.radius, p.walls, 1e-3);
+    ASSERT_TRUE(mixed.cholmod().single_precision());
+    const auto [lo, hi] = std::minmax_element(exact.pressure().begin(), exact.pressure().end());
+    const double spread = *hi - *lo;
+    ASSERT_GT(spread, 0.5);
+    for (std::size_t c = 0; c < exact.pressure().size(); ++c)
+      // 5e-9: the double reference itself carries ~1e-9 Pa of round-off at 1e5 Pa; a tolerance
+      // taken relative to max|p| leaves 3e-8 here.
+      ASSERT_NEAR(mixed.pressure()[c], exact.pressure()[c], 5e-9 * spread) << "step " << step << " cell " << c;
+  }
+}
+
 TEST(MixedPrecision, LongChainConvergesDespiteItsConditionNumber) {
   // cond(G) ~ 16 n^2 / pi^2 ~ 6e8, beyond float's 1 / 6e-8 - yet G is a graph Laplacian (an
   // M-matrix) whose rounded factor stays a componentwise-small perturbation: refinement still

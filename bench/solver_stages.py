@@ -175,7 +175,7 @@ def collective_limit(pos, rad, walls):
     t0 = time.perf_counter()
     power = []
     for _ in range(40):
-        limit, mode = e.viscous_stability_mode(mass, 3, mode)
+        limit, mode, _ = e.viscous_stability_mode(mass, 3, mode)
         power.append(limit)
     t_power = (time.perf_counter() - t0) / 3  # per 40 iterations
     print('   Arnoldi %.7g s in %.3f s; power iteration: %.7g after 39 iterations (%.3f s), %.7g after 120; '

@@ -57,9 +57,11 @@ class FlowEngine {
   // stopping once the largest Ritz value changes by less than 1e-6. mode: if given with one
   // entry per sphere (not all zero), power iteration starts from it instead (warm start from
   // the previous mesh's mode, stopping once the estimate changes by less than 0.5 %). On
-  // return mode holds the estimated eigenvector (unit norm).
+  // return mode holds the estimated eigenvector (unit norm), and applications (if given) the
+  // number of operator applications made. Throws std::domain_error if the operator gives a
+  // non-finite estimate.
   double viscous_stability_limit(const std::vector<double>& mass, int iterations,
-                                 std::vector<Vec3>* mode = nullptr) const;
+                                 std::vector<Vec3>* mode = nullptr, int* applications = nullptr) const;
   // accel = M^-1 F(v): the fluid forces of the sphere velocities v on the current mesh over
   // the masses (zero for mass <= 0). The operator of viscous_stability_limit; public for tests.
   void apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,

@@ -260,14 +260,16 @@ PYBIND11_MODULE(_core, m) {
              std::vector<Vec3> mode;
              if (!start.is_none()) mode = to_points(start.cast<Array>(), "start");
              double limit;
+             int applications = 0;
              {
                py::gil_scoped_release release;
-               limit = e.viscous_stability_limit(m, iterations, &mode);
+               limit = e.viscous_stability_limit(m, iterations, &mode, &applications);
              }
-             return py::make_tuple(limit, points_to_array(mode));
+             return py::make_tuple(limit, points_to_array(mode), applications);
            }, py::arg("masses"), py::arg("iterations") = 40, py::arg("start") = py::none(),
-           "(limit, mode): as viscous_stability_limit, started from `start` (one velocity per sphere, e.g. the\n"
-           "mode returned on the previous mesh) when given; mode is the last iterate.")
+           "(limit, mode, applications): as viscous_stability_limit, by power iteration from `start` (one\n"
+           "velocity per sphere, e.g. the mode returned on the previous mesh) when given, else by Arnoldi; mode is\n"
+           "the estimated eigenvector, applications the operator applications made (each a solve).")
       .def("forces", [](const FlowEngine& e) { return points_to_array(e.forces()); },
            "Fluid force on every sphere (input order), then on the six walls.")
       .def("shear_forces", [](const FlowEngine& e) { return points_to_array(e.shear_forces()); },

@@ -14,6 +14,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "flow_engine.hpp"
 #include "gauss_seidel_solver.hpp"
@@ -72,10 +73,15 @@ void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const s
 }
 
 double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations,
-                                           std::vector<Vec3>* mode) const {
+                                           std::vector<Vec3>* mode, int* applications) const {
+  int applied = 0;
+  if (applications) *applications = 0;
   if (!has_mesh() || !has_prev_) throw std::logic_error("the stability limit needs a mesh: run a step first");
   const int n = mesh().n_spheres;
   if (static_cast<int>(mass.size()) != n) throw std::invalid_argument("one mass per sphere is needed");
+  for (int k = 0; k < n; ++k)
+    if (!std::isfinite(mass[k]))
+      throw std::invalid_argument("mass of sphere " + std::to_string(k) + " is not finite");
   const int nu = linear_.system.n_unknowns();
   if (nu == 0 || (!linear_.cholmod->ready() && !linear_.pcg.ready() && settings.use_solver != 0)) return HUGE_VAL;
 
@@ -103,6 +109,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
   if (warm) {
     for (int it = 0; it < iterations; ++it) {
       apply_viscous_operator(mass, v, w);
+      ++applied;
       const double previous = lambda;
       lambda = std::sqrt(dot(w, w));  // |M^-1 V v| for |v| = 1
       if (lambda == 0) return HUGE_VAL;
@@ -119,6 +126,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
     Eigen::VectorXcd ritz_vector;
     for (int j = 0; j < m; ++j) {
       apply_viscous_operator(mass, q[j], w);
+      ++applied;
       for (int pass = 0; pass < 2; ++pass)  // Gram-Schmidt twice: orthogonal to round-off
         for (int i = 0; i <= j; ++i) {
           const double c = dot(q[i], w);
@@ -147,6 +155,10 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
     if (vn > 0)
       for (Vec3& u : v) u /= vn;
   }
+  if (applications) *applications = applied;
+  if (!std::isfinite(lambda))
+    throw std::domain_error("the collective viscous stability limit is not finite (the linearised fluid operator "
+                            "gave NaN or infinity: check the positions, masses and viscosity)");
   if (mode) *mode = std::move(v);
   return 2.0 / lambda;
 }

@@ -68,6 +68,14 @@ TEST(ViscousStability, ArnoldiAndPowerIterationMatchTheDenseSpectrum) {
   EXPECT_NEAR(warm, 2 / ref.lambda_max, 5e-3 * warm);
   EXPECT_GT(alignment(mode, ref.mode), 0.99);
 
+  int applications = 0;
+  e.viscous_stability_limit(mass, 40, nullptr, &applications);
+  EXPECT_GT(applications, 5);
+  EXPECT_LE(applications, 40);
+  std::vector<double> bad = mass;
+  bad[7] = std::nan("");
+  EXPECT_THROW(e.viscous_stability_limit(bad, 40), std::invalid_argument);
+
   // Fewer operator applications than the spectrum needs: an estimate from inside the
   // spectrum, i.e. a limit above the true one (why the engine keeps a safety factor).
   EXPECT_GE(e.viscous_stability_limit(mass, 3), 2 / ref.lambda_max * (1 - 1e-9));

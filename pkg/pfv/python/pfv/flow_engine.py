@@ -349,7 +349,7 @@ class FlowEngine(PyRunner):
         once the estimate settles to 1e-6), afterwards by power iteration started from the
         previous mesh's mode (at most collective_iterations_warm = 10). Each operator application
         costs one back-substitution and one force evaluation; see collective_viscous_history
-        ("iterations" there is the cap, "seconds" the cost)."""
+        ("iterations" there is the count made, "max_iterations" the cap, "seconds" the cost)."""
         core = self._core
         if not core.has_mesh():
             return float("inf")
@@ -361,21 +361,23 @@ class FlowEngine(PyRunner):
             warm = mode is not None and len(mode) == len(self._masses) and self._dt_collective is not None
             iterations = self.collective_iterations_warm if warm else self.collective_iterations
             t0 = time.perf_counter()
-            limit, mode = core.viscous_stability_mode(self._masses, iterations, mode if warm else None)
+            limit, mode, applied = core.viscous_stability_mode(self._masses, iterations, mode if warm else None)
             seconds = time.perf_counter() - t0
             object.__setattr__(self, "_dt_collective", limit)
             object.__setattr__(self, "_collective_mode", mode if len(mode) else None)
             object.__setattr__(self, "_collective_viscosity", key)
             object.__setattr__(self, "_collective_mesh", core.remesh_count)
             self._collective_history.append(dict(
-                iter=yade.O.iter, remesh_count=core.remesh_count, limit=limit, iterations=iterations,
+                iter=yade.O.iter, remesh_count=core.remesh_count, limit=limit, iterations=applied,
+                max_iterations=iterations,
                 warm=warm, seconds=seconds))
         return self._dt_collective
 
     @property
     def collective_viscous_history(self):
         """One dict per computation of the collective limit: iter, remesh_count, limit [s],
-        iterations, warm (started from the previous mode), seconds (wall time of the iteration)."""
+        iterations (operator applications made, each a solve and a force evaluation), max_iterations (the cap),
+        warm (power iteration from the previous mode; cold: Arnoldi), seconds (wall time)."""
         return list(self._collective_history)
 
     @property

@@ -17,15 +17,9 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
 import flow_benchmark as fb  # noqa: E402  (packing cache, scene, engine set-up)
+from solver_stages import option  # noqa: E402
 
 from yade import O  # noqa: E402
-
-
-def option(name, default):
-    for a in sys.argv[1:]:
-        if a.startswith('--%s=' % name):
-            return a.split('=', 1)[1]
-    return default
 
 
 def run(steps, mixed, tolerance=None):
@@ -55,8 +49,8 @@ def run(steps, mixed, tolerance=None):
 
 
 def main():
-    n = int(option('size', '10000'))
-    steps = int(option('steps', '20'))
+    n = option('size', 10000)
+    steps = option('steps', 20)
     tolerances = [float(t) for t in option('tolerances', '1e-10,1e-8').split(',')]
     fb.build_scene(n)
     O.saveTmp('bench')

@@ -74,7 +74,6 @@ void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const s
 
 double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations,
                                            std::vector<Vec3>* mode, int* applications) const {
-  int applied = 0;
   if (applications) *applications = 0;
   if (!has_mesh() || !has_prev_) throw std::logic_error("the stability limit needs a mesh: run a step first");
   const int n = mesh().n_spheres;
@@ -105,6 +104,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
   for (Vec3& u : v) u /= std::sqrt(norm2);
 
   double lambda = 0;
+  int applied = 0;
   std::vector<Vec3> w;
   if (warm) {
     for (int it = 0; it < iterations; ++it) {
@@ -112,7 +112,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
       ++applied;
       const double previous = lambda;
       lambda = std::sqrt(dot(w, w));  // |M^-1 V v| for |v| = 1
-      if (lambda == 0) return HUGE_VAL;
+      if (lambda == 0) break;  // no fluid force for any motion: no limit
       v.swap(w);
       for (Vec3& u : v) u /= lambda;
       if (it >= 2 && std::abs(lambda - previous) <= kWarmSettled * lambda) break;
@@ -146,7 +146,6 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
       q.emplace_back(w);
       for (Vec3& u : q.back()) u /= H(j + 1, j);
     }
-    if (lambda == 0) return HUGE_VAL;
     // The Ritz vector (real part; the wanted eigenvalue is real up to round-off) as the mode.
     v.assign(n, Vec3::Zero());
     for (int i = 0; i < ritz_vector.size(); ++i)
@@ -156,6 +155,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
       for (Vec3& u : v) u /= vn;
   }
   if (applications) *applications = applied;
+  if (lambda == 0) return HUGE_VAL;
   if (!std::isfinite(lambda))
     throw std::domain_error("the collective viscous stability limit is not finite (the linearised fluid operator "
                             "gave NaN or infinity: check the positions, masses and viscosity)");

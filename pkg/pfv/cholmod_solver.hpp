@@ -50,12 +50,12 @@ class CholmodSolver {
   // the rounded factor does not converge (G too ill-conditioned for float).
   void promote_to_double(const PressureSystem& system);
   // x ~ G^-1 rhs; exact to round-off in double, to about cond(G) * 6e-8 in single precision.
-  // With two or more OpenMP threads the substitutions run on subtrees in parallel
-  // (parallel_substitution.hpp); with one, CHOLMOD's own (BLAS-based) solve is used in double
-  // and the same subtree plan, run serially, in single precision.
+  // Always PFV's own substitution (parallel_substitution.hpp) on the compacted factor, whose
+  // values CHOLMOD can no longer read: with two or more OpenMP threads on subtrees in parallel.
   void solve(const std::vector<double>& rhs, std::vector<double>& x);
   // See EngineSettings::cholmod_openmp_teams; applies to the factorisations that follow.
   void set_openmp_teams(bool on) { openmp_teams_ = on; }
+  // The same on the calling thread only (the same arithmetic, the same result).
   void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
   bool single_precision() const { return values32_ != nullptr; }
   double parallel_top_fraction() const { return parallel_.top_fraction(); }
@@ -77,10 +77,7 @@ class CholmodSolver {
   Common* common_;
   bool openmp_teams_ = false;
   void* factor_ = nullptr;  // cholmod_factor*
-  void* rhs_ = nullptr;     // cholmod_dense*, reused
-  void* x_ = nullptr;
-  void* work_y_ = nullptr;
-  void* work_e_ = nullptr;
+  std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
   const float* values32_ = nullptr;  // the factor's values rounded, in CHOLMOD's array; or null
   ParallelSubstitution parallel_;
   bool metis_used_ = false;

@@ -20,6 +20,29 @@ inline Real dot(const Real* a, const Real* b, int n) {
   return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
+// Column j of a trapezoid block of nsrow rows, indexed by row (entries j..nsrow-1 exist).
+template <class Real>
+inline const Real* trapezoid_column(const Real* block, std::ptrdiff_t nsrow, std::ptrdiff_t j) {
+  return block + j * nsrow - j * (j + 1) / 2;
+}
+
+// The forward sweep reads the factor as one ascending stream, but in short pieces (most
+// supernodes are a few hundred bytes): the hardware prefetcher restarts on each, and the sweep
+// waits for memory. Asking for the bytes kPrefetchAhead ahead of the block being read keeps
+// the stream going (10 000 spheres, factor out of cache: forward sweep 5.4 -> 4.0 ms in float,
+// 7.1 -> 5.7 ms in double, together with the four-column rectangle). The backward sweep gained
+// nothing from the same (tried).
+constexpr std::ptrdiff_t kPrefetchAhead = 2048;
+
+template <class Real>
+inline void prefetch_ahead(const Real* block, const Real* block_end, const Real* values_end) {
+  const char* a = reinterpret_cast<const char*>(block);
+  const char* z = reinterpret_cast<const char*>(block_end);
+  const char* end = reinterpret_cast<const char*>(values_end);
+  if (end - z <= kPrefetchAhead) return;  // the end of the stream: nothing to ask for
+  for (a += kPrefetchAhead, z += kPrefetchAhead; a < z; a += 64) __builtin_prefetch(a);
+}
+
 inline int thread_index() {
 #ifdef _OPENMP
   return omp_get_thread_num();
@@ -139,16 +162,28 @@ void ParallelSubstitution::forward(const Real* values, Workspace<Real>& ws, int 
   const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1;
   const int nsrow = L_.pi[s + 1] - L_.pi[s], nrest = nsrow - nscol;
   const int* r = L_.rows + L_.pi[s] + nscol;
-  const Real* Ls = values + L_.px[s];
+  const Real* Ls = values + L_.start[s];
+  prefetch_ahead(Ls, values + L_.start[s + 1], values + L_.start[L_.nsuper]);
   Real* y = ws.y.data();
   for (int j = 0; j < nscol; ++j) {  // the dense triangle
-    const Real* col = Ls + static_cast<std::ptrdiff_t>(j) * nsrow;
+    const Real* col = trapezoid_column(Ls, nsrow, j);
     const Real xj = (y[k1 + j] /= col[j]);
     for (int i = j + 1; i < nscol; ++i) y[k1 + i] -= col[i] * xj;
   }
+  // The rectangle below it, w = L21 y1, four columns per sweep over w: with one column per
+  // sweep the loads and stores of w, not the factor, bound the narrow supernodes.
   std::fill(w, w + nrest, Real(0));
-  for (int j = 0; j < nscol; ++j) {  // the rectangle below it
-    const Real* off = Ls + static_cast<std::ptrdiff_t>(j) * nsrow + nscol;
+  int j = 0;
+  for (; j + 4 <= nscol; j += 4) {
+    const Real* o0 = trapezoid_column(Ls, nsrow, j) + nscol;
+    const Real* o1 = trapezoid_column(Ls, nsrow, j + 1) + nscol;
+    const Real* o2 = trapezoid_column(Ls, nsrow, j + 2) + nscol;
+    const Real* o3 = trapezoid_column(Ls, nsrow, j + 3) + nscol;
+    const Real x0 = y[k1 + j], x1 = y[k1 + j + 1], x2 = y[k1 + j + 2], x3 = y[k1 + j + 3];
+    for (int i = 0; i < nrest; ++i) w[i] += (o0[i] * x0 + o1[i] * x1) + (o2[i] * x2 + o3[i] * x3);
+  }
+  for (; j < nscol; ++j) {
+    const Real* off = trapezoid_column(Ls, nsrow, j) + nscol;
     const Real xj = y[k1 + j];
     for (int i = 0; i < nrest; ++i) w[i] += off[i] * xj;
   }
@@ -169,11 +204,11 @@ void ParallelSubstitution::backward(const Real* values, Workspace<Real>& ws, int
   const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1;
   const int nsrow = L_.pi[s + 1] - L_.pi[s], nrest = nsrow - nscol;
   const int* r = L_.rows + L_.pi[s] + nscol;
-  const Real* Ls = values + L_.px[s];
+  const Real* Ls = values + L_.start[s];
   Real* y = ws.y.data();
   for (int i = 0; i < nrest; ++i) w[i] = y[r[i]];
   for (int j = nscol - 1; j >= 0; --j) {
-    const Real* col = Ls + static_cast<std::ptrdiff_t>(j) * nsrow;
+    const Real* col = trapezoid_column(Ls, nsrow, j);
     const Real t = y[k1 + j] - dot(col + nscol, w, nrest) - dot(col + j + 1, y + k1 + j + 1, nscol - j - 1);
     y[k1 + j] = t / col[j];
   }

@@ -12,14 +12,17 @@
 
 namespace pfv {
 
-// A read-only view of CHOLMOD's supernodal LL' factor (see cholmod_factor: super, pi, px, s).
-// The values are either CHOLMOD's doubles or a single-precision copy (exactly one is set):
-// the substitution reads every factor entry once per pass, so floats halve its memory traffic.
+// A read-only view of a supernodal LL' factor with CHOLMOD's pattern (cholmod_factor: super,
+// pi, s, Perm) and compacted values: supernode s (columns super[s]..super[s+1]-1, rows
+// rows[pi[s]..pi[s+1]-1], nsrow of them) starts at values[start[s]], column by column, column j
+// holding only its rows j..nsrow-1 (the lower trapezoid). The values are doubles or floats
+// (exactly one is set): the substitution reads every entry once per pass, so floats halve its
+// memory traffic.
 struct SupernodalFactor {
   int n = 0, nsuper = 0;
   const int* super = nullptr;
   const int* pi = nullptr;
-  const int* px = nullptr;
+  const long* start = nullptr;
   const int* rows = nullptr;
   const int* perm = nullptr;
   const double* values = nullptr;

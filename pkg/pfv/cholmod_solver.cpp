@@ -224,8 +224,10 @@ std::vector<long> compact_to_trapezoids(Real* v, const cholmod_factor& f) {
 
 void CholmodSolver::plan_substitution() {
   auto* f = static_cast<cholmod_factor*>(factor_);
-  if (!f->is_super || !f->is_ll)  // CHOLMOD_SUPERNODAL is requested in the constructor
+  if (!f->is_super || !f->is_ll) {  // CHOLMOD_SUPERNODAL is requested in the constructor
+    release();
     throw std::logic_error("CHOLMOD returned a simplicial factor; ParallelSubstitution needs a supernodal LL'");
+  }
   SupernodalFactor view;
   view.n = static_cast<int>(f->n);
   view.nsuper = static_cast<int>(f->nsuper);
@@ -249,25 +251,23 @@ void CholmodSolver::plan_substitution() {
 
 void CholmodSolver::solve(const std::vector<double>& rhs, std::vector<double>& x) {
 #ifdef _OPENMP
-  const bool threads = omp_get_max_threads() > 1;
+  solve_on(rhs, x, omp_get_max_threads() > 1);
 #else
-  const bool threads = false;
+  solve_on(rhs, x, false);
 #endif
+}
+
+void CholmodSolver::solve_serial(const std::vector<double>& rhs, std::vector<double>& x) {
+  solve_on(rhs, x, false);
+}
+
+void CholmodSolver::solve_on(const std::vector<double>& rhs, std::vector<double>& x, bool threads) {
   if (!factor_) {
     x.clear();
     return;
   }
   x.resize(rhs.size());
   parallel_.solve(rhs.data(), x.data(), threads);
-}
-
-void CholmodSolver::solve_serial(const std::vector<double>& rhs, std::vector<double>& x) {
-  if (!factor_) {
-    x.clear();
-    return;
-  }
-  x.resize(rhs.size());
-  parallel_.solve(rhs.data(), x.data(), false);
 }
 
 }  // namespace pfv

@@ -71,6 +71,7 @@ class CholmodSolver {
 
  private:
   void release();
+  void solve_on(const std::vector<double>& rhs, std::vector<double>& x, bool threads);
   void numeric_factorization(const PressureSystem& system);
   void plan_substitution();
   struct Common;

@@ -59,6 +59,7 @@ class CholmodSolver {
   void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
   bool single_precision() const { return values32_ != nullptr; }
   double parallel_top_fraction() const { return parallel_.top_fraction(); }
+  int shared_top_supernodes() const { return parallel_.shared_top_supernodes(); }
   bool metis_used() const { return metis_used_; }
   bool ordering_given() const { return ordering_given_; }  // the given order was kept
   const int* permutation() const;  // unknown eliminated k-th, after CHOLMOD's postorder

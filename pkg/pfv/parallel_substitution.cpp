@@ -51,6 +51,14 @@ inline int thread_index() {
 #endif
 }
 
+inline int omp_team_size() {
+#ifdef _OPENMP
+  return omp_get_num_threads();
+#else
+  return 1;
+#endif
+}
+
 }  // namespace
 
 void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
@@ -140,6 +148,8 @@ void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
     }
   }
   top_fraction_ = total > 0 ? top_entries / total : 1;
+  shared_.clear();
+  for (int s : top_) shared_.push_back(threads > 1 && f.start[s + 1] - f.start[s] >= kMinSharedEntries);
   const auto size = [&](auto& ws) {
     ws.acc.assign(groups_.size(), {});
     ws.work.assign(groups_.size(), {});
@@ -214,6 +224,104 @@ void ParallelSubstitution::backward(const Real* values, Workspace<Real>& ws, int
   }
 }
 
+namespace {
+
+// The part [a, b) of the range [lo, hi) that thread t of nt takes.
+inline std::pair<int, int> share(int lo, int hi, int t, int nt) {
+  const long n = hi - lo;
+  return {lo + static_cast<int>(n * t / nt), lo + static_cast<int>(n * (t + 1) / nt)};
+}
+
+inline void barrier() {
+#pragma omp barrier
+}
+
+}  // namespace
+
+// The supernode's rows in one vector u (its own columns, then the rows below), solved by
+// blocks of kSharedBlock columns: the small triangle of a block on thread 0, then the update
+// of all rows below the block split between the threads. Every row sees the same operations
+// in the same order whatever nt is.
+template <class Real>
+void ParallelSubstitution::forward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt) {
+  const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1, nsrow = L_.pi[s + 1] - L_.pi[s];
+  const int* r = L_.rows + L_.pi[s] + nscol;
+  const Real* Ls = values + L_.start[s];
+  Real* y = ws.y.data();
+  Real* u = ws.work[0].data();
+  {
+    const auto [a, b] = share(0, nsrow, t, nt);
+    for (int i = a; i < b; ++i) u[i] = i < nscol ? y[k1 + i] : Real(0);
+  }
+  barrier();
+  for (int j0 = 0; j0 < nscol; j0 += kSharedBlock) {
+    const int j1 = std::min(j0 + kSharedBlock, nscol);
+    if (t == 0)
+      for (int j = j0; j < j1; ++j) {
+        const Real* col = trapezoid_column(Ls, nsrow, j);
+        const Real xj = (u[j] /= col[j]);
+        for (int i = j + 1; i < j1; ++i) u[i] -= col[i] * xj;
+      }
+    barrier();
+    const auto [a, b] = share(j1, nsrow, t, nt);
+    int j = j0;
+    for (; j + 4 <= j1; j += 4) {
+      const Real* c0 = trapezoid_column(Ls, nsrow, j);
+      const Real* c1 = trapezoid_column(Ls, nsrow, j + 1);
+      const Real* c2 = trapezoid_column(Ls, nsrow, j + 2);
+      const Real* c3 = trapezoid_column(Ls, nsrow, j + 3);
+      const Real x0 = u[j], x1 = u[j + 1], x2 = u[j + 2], x3 = u[j + 3];
+      for (int i = a; i < b; ++i) u[i] -= (c0[i] * x0 + c1[i] * x1) + (c2[i] * x2 + c3[i] * x3);
+    }
+    for (; j < j1; ++j) {
+      const Real* col = trapezoid_column(Ls, nsrow, j);
+      const Real xj = u[j];
+      for (int i = a; i < b; ++i) u[i] -= col[i] * xj;
+    }
+    barrier();
+  }
+  const auto [a, b] = share(0, nsrow, t, nt);
+  for (int i = a; i < b; ++i) {  // the rows below belong to no other supernode of the top phase
+    if (i < nscol)
+      y[k1 + i] = u[i];
+    else
+      y[r[i - nscol]] += u[i];  // u holds minus the update
+  }
+  barrier();
+}
+
+// Blocks from the last: the dots of a block's columns with the rows below it, split between
+// the threads by columns, then the block's triangle on thread 0.
+template <class Real>
+void ParallelSubstitution::backward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt) {
+  const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1, nsrow = L_.pi[s + 1] - L_.pi[s];
+  const int* r = L_.rows + L_.pi[s] + nscol;
+  const Real* Ls = values + L_.start[s];
+  Real* y = ws.y.data();
+  Real* u = ws.work[0].data();
+  {
+    const auto [a, b] = share(0, nsrow, t, nt);
+    for (int i = a; i < b; ++i) u[i] = i < nscol ? y[k1 + i] : y[r[i - nscol]];
+  }
+  barrier();
+  for (int j1 = nscol; j1 > 0;) {
+    const int j0 = std::max(0, j1 - kSharedBlock);
+    const auto [a, b] = share(j0, j1, t, nt);
+    for (int j = a; j < b; ++j) u[j] -= dot(trapezoid_column(Ls, nsrow, j) + j1, u + j1, nsrow - j1);
+    barrier();
+    if (t == 0)
+      for (int j = j1 - 1; j >= j0; --j) {
+        const Real* col = trapezoid_column(Ls, nsrow, j);
+        u[j] = (u[j] - dot(col + j + 1, u + j + 1, j1 - j - 1)) / col[j];
+      }
+    barrier();
+    j1 = j0;
+  }
+  const auto [a, b] = share(0, nscol, t, nt);
+  for (int i = a; i < b; ++i) y[k1 + i] = u[i];
+  barrier();
+}
+
 void ParallelSubstitution::solve(const double* b, double* x, bool parallel) {
   if (L_.values32)
     solve_with(L_.values32, ws32_, b, x, parallel);
@@ -236,9 +344,10 @@ void ParallelSubstitution::solve_with(const Real* values, Workspace<Real>& ws, c
     for (auto g = groups_[t].rbegin(); g != groups_[t].rend(); ++g)
       for (int s = g->second; s >= g->first; --s) backward(values, ws, s, ws.work[t].data());
   };
+  // A team smaller than asked for (a thread limit, a nested region) still covers every group.
   if (parallel) {
 #pragma omp parallel num_threads(groups)
-    forward_group(thread_index());
+    for (int g = thread_index(); g < groups; g += omp_team_size()) forward_group(g);
   } else {
     for (int t = 0; t < groups; ++t) forward_group(t);
   }
@@ -247,11 +356,35 @@ void ParallelSubstitution::solve_with(const Real* values, Workspace<Real>& ws, c
       ws.y[k] -= ws.acc[t][k];
       ws.acc[t][k] = 0;
     }
-  for (int s : top_) forward(values, ws, s, static_cast<Real*>(nullptr), ws.work[0].data());
-  for (auto it = top_.rbegin(); it != top_.rend(); ++it) backward(values, ws, *it, ws.work[0].data());
+  // The top, on one thread except for the shared supernodes, whose pieces need all threads.
+  const auto top = [&](int t, int nt) {
+    const int nt_top = static_cast<int>(top_.size());
+    for (int k = 0; k < nt_top; ++k) {
+      if (shared_[k]) {
+        forward_shared(values, ws, top_[k], t, nt);
+      } else {
+        if (t == 0) forward(values, ws, top_[k], static_cast<Real*>(nullptr), ws.work[0].data());
+        barrier();
+      }
+    }
+    for (int k = nt_top - 1; k >= 0; --k) {
+      if (shared_[k]) {
+        backward_shared(values, ws, top_[k], t, nt);
+      } else {
+        if (t == 0) backward(values, ws, top_[k], ws.work[0].data());
+        barrier();
+      }
+    }
+  };
+  if (parallel && std::find(shared_.begin(), shared_.end(), 1) != shared_.end()) {
+#pragma omp parallel num_threads(groups)
+    top(thread_index(), omp_team_size());
+  } else {
+    top(0, 1);
+  }
   if (parallel) {
 #pragma omp parallel num_threads(groups)
-    backward_group(thread_index());
+    for (int g = thread_index(); g < groups; g += omp_team_size()) backward_group(g);
   } else {
     for (int t = 0; t < groups; ++t) backward_group(t);
   }

@@ -7,6 +7,7 @@
 // then the top; backwards the top first, then the groups in parallel. The solve is bound by
 // reading the factor, so a second core adds memory bandwidth, and a float factor halves it.
 #pragma once
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -33,9 +34,16 @@ class ParallelSubstitution {
  public:
   void plan(const SupernodalFactor& factor, int threads);
   int threads() const { return static_cast<int>(groups_.size()); }
-  double top_fraction() const { return top_fraction_; }  // share of entries solved serially
+  double top_fraction() const { return top_fraction_; }  // share of entries in the top
+  // Top supernodes large enough to be shared between the threads, by rows (forward) and by
+  // columns (backward) of blocks of kSharedBlock columns. The top is mostly the last
+  // separators: at 10 000 spheres one dense block of 1 200 columns, 12 % of the entries.
+  int shared_top_supernodes() const { return static_cast<int>(std::count(shared_.begin(), shared_.end(), 1)); }
+  static constexpr long kMinSharedEntries = 1 << 16;
+  static constexpr int kSharedBlock = 64;
   // x = (L L')^-1 applied to b in the original ordering. With parallel = false the groups
-  // run one after the other on the calling thread (same arithmetic, same result).
+  // and the shared supernodes' pieces run one after the other on the calling thread (same
+  // arithmetic, the same result to the bit).
   void solve(const double* b, double* x, bool parallel = true);
 
  private:
@@ -51,12 +59,18 @@ class ParallelSubstitution {
   void forward(const Real* values, Workspace<Real>& ws, int s, Real* acc, Real* w);
   template <class Real>
   void backward(const Real* values, Workspace<Real>& ws, int s, Real* w);
+  // Thread t of nt's part of supernode s (a top one, after all of its descendants).
+  template <class Real>
+  void forward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt);
+  template <class Real>
+  void backward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt);
   template <class Real>
   void solve_with(const Real* values, Workspace<Real>& ws, const double* b, double* x, bool parallel);
 
   SupernodalFactor L_;
   std::vector<std::vector<std::pair<int, int>>> groups_;  // per thread: supernode ranges
   std::vector<int> top_;                                  // top supernodes, increasing
+  std::vector<char> shared_;                              // per top_ entry
   std::vector<char> top_row_;                             // per row: owned by a top supernode
   std::vector<int> top_rows_;
   Workspace<double> ws64_;

@@ -26,11 +26,34 @@ inline const Real* trapezoid_column(const Real* block, std::ptrdiff_t nsrow, std
   return block + j * nsrow - j * (j + 1) / 2;
 }
 
+// u[i] -= sum over columns j in [j0, j1) of L(row0 + i, j) x[j], for i < count, four columns
+// per sweep over u: with one column per sweep the loads and stores of u, not the factor,
+// bound the narrow supernodes. The rows row0.. must lie below column j1 - 1's diagonal.
+template <class Real>
+inline void subtract_columns(const Real* block, int nsrow, int j0, int j1, const Real* x, int row0, Real* u,
+                             int count) {
+  int j = j0;
+  for (; j + 4 <= j1; j += 4) {
+    const Real* c0 = trapezoid_column(block, nsrow, j) + row0;
+    const Real* c1 = trapezoid_column(block, nsrow, j + 1) + row0;
+    const Real* c2 = trapezoid_column(block, nsrow, j + 2) + row0;
+    const Real* c3 = trapezoid_column(block, nsrow, j + 3) + row0;
+    const Real x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
+    for (int i = 0; i < count; ++i) u[i] -= (c0[i] * x0 + c1[i] * x1) + (c2[i] * x2 + c3[i] * x3);
+  }
+  for (; j < j1; ++j) {
+    const Real* col = trapezoid_column(block, nsrow, j) + row0;
+    const Real xj = x[j];
+    for (int i = 0; i < count; ++i) u[i] -= col[i] * xj;
+  }
+}
+
 // The forward sweep reads the factor as one ascending stream, but in short pieces (most
 // supernodes are a few hundred bytes): the hardware prefetcher restarts on each, and the sweep
 // waits for memory. Asking for the bytes kPrefetchAhead ahead of the block being read keeps
-// the stream going (10 000 spheres, factor out of cache: forward sweep 5.4 -> 4.0 ms in float,
-// 7.1 -> 5.7 ms in double, together with the four-column rectangle). The backward sweep gained
+// the stream going (development measurement, 10 000 spheres, factor out of cache: forward
+// sweep 5.4 -> 4.0 ms in float, 7.1 -> 5.7 ms in double, together with the four-column
+// rectangle; doc/benchmarks.md has the project scripts' numbers). The backward sweep gained
 // nothing from the same (tried).
 constexpr std::ptrdiff_t kPrefetchAhead = 2048;
 
@@ -169,58 +192,42 @@ void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
 
 template <class Real>
 void ParallelSubstitution::forward(const Real* values, Workspace<Real>& ws, int s, Real* acc, Real* w) {
-  const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1;
-  const int nsrow = L_.pi[s + 1] - L_.pi[s], nrest = nsrow - nscol;
-  const int* r = L_.rows + L_.pi[s] + nscol;
-  const Real* Ls = values + L_.start[s];
-  prefetch_ahead(Ls, values + L_.start[s + 1], values + L_.start[L_.nsuper]);
-  Real* y = ws.y.data();
-  for (int j = 0; j < nscol; ++j) {  // the dense triangle
-    const Real* col = trapezoid_column(Ls, nsrow, j);
-    const Real xj = (y[k1 + j] /= col[j]);
-    for (int i = j + 1; i < nscol; ++i) y[k1 + i] -= col[i] * xj;
+  const Block<Real> b = block(values, s);
+  const int nrest = b.nsrow - b.nscol;
+  prefetch_ahead(b.L, values + L_.start[s + 1], values + L_.start[L_.nsuper]);
+  Real* y = ws.y.data() + b.k1;  // this supernode's rows
+  for (int j = 0; j < b.nscol; ++j) {  // the dense triangle
+    const Real* col = trapezoid_column(b.L, b.nsrow, j);
+    const Real xj = (y[j] /= col[j]);
+    for (int i = j + 1; i < b.nscol; ++i) y[i] -= col[i] * xj;
   }
-  // The rectangle below it, w = L21 y1, four columns per sweep over w: with one column per
-  // sweep the loads and stores of w, not the factor, bound the narrow supernodes.
+  // The rectangle below it: w = -L21 y1.
   std::fill(w, w + nrest, Real(0));
-  int j = 0;
-  for (; j + 4 <= nscol; j += 4) {
-    const Real* o0 = trapezoid_column(Ls, nsrow, j) + nscol;
-    const Real* o1 = trapezoid_column(Ls, nsrow, j + 1) + nscol;
-    const Real* o2 = trapezoid_column(Ls, nsrow, j + 2) + nscol;
-    const Real* o3 = trapezoid_column(Ls, nsrow, j + 3) + nscol;
-    const Real x0 = y[k1 + j], x1 = y[k1 + j + 1], x2 = y[k1 + j + 2], x3 = y[k1 + j + 3];
-    for (int i = 0; i < nrest; ++i) w[i] += (o0[i] * x0 + o1[i] * x1) + (o2[i] * x2 + o3[i] * x3);
-  }
-  for (; j < nscol; ++j) {
-    const Real* off = trapezoid_column(Ls, nsrow, j) + nscol;
-    const Real xj = y[k1 + j];
-    for (int i = 0; i < nrest; ++i) w[i] += off[i] * xj;
-  }
+  subtract_columns(b.L, b.nsrow, 0, b.nscol, y, b.nscol, w, nrest);
+  Real* all = ws.y.data();
   if (acc) {  // top rows are shared between threads: collect their updates apart
     for (int i = 0; i < nrest; ++i) {
-      if (top_row_[r[i]])
-        acc[r[i]] += w[i];
+      if (top_row_[b.rows[i]])
+        acc[b.rows[i]] -= w[i];
       else
-        y[r[i]] -= w[i];
+        all[b.rows[i]] += w[i];
     }
   } else {
-    for (int i = 0; i < nrest; ++i) y[r[i]] -= w[i];
+    for (int i = 0; i < nrest; ++i) all[b.rows[i]] += w[i];
   }
 }
 
 template <class Real>
 void ParallelSubstitution::backward(const Real* values, Workspace<Real>& ws, int s, Real* w) {
-  const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1;
-  const int nsrow = L_.pi[s + 1] - L_.pi[s], nrest = nsrow - nscol;
-  const int* r = L_.rows + L_.pi[s] + nscol;
-  const Real* Ls = values + L_.start[s];
+  const Block<Real> b = block(values, s);
+  const int nrest = b.nsrow - b.nscol;
   Real* y = ws.y.data();
-  for (int i = 0; i < nrest; ++i) w[i] = y[r[i]];
-  for (int j = nscol - 1; j >= 0; --j) {
-    const Real* col = trapezoid_column(Ls, nsrow, j);
-    const Real t = y[k1 + j] - dot(col + nscol, w, nrest) - dot(col + j + 1, y + k1 + j + 1, nscol - j - 1);
-    y[k1 + j] = t / col[j];
+  for (int i = 0; i < nrest; ++i) w[i] = y[b.rows[i]];
+  y += b.k1;
+  for (int j = b.nscol - 1; j >= 0; --j) {
+    const Real* col = trapezoid_column(b.L, b.nsrow, j);
+    const Real t = y[j] - dot(col + b.nscol, w, nrest) - dot(col + j + 1, y + j + 1, b.nscol - j - 1);
+    y[j] = t / col[j];
   }
 }
 
@@ -244,48 +251,33 @@ inline void barrier() {
 // in the same order whatever nt is.
 template <class Real>
 void ParallelSubstitution::forward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt) {
-  const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1, nsrow = L_.pi[s + 1] - L_.pi[s];
-  const int* r = L_.rows + L_.pi[s] + nscol;
-  const Real* Ls = values + L_.start[s];
+  const Block<Real> b = block(values, s);
   Real* y = ws.y.data();
   Real* u = ws.work[0].data();
   {
-    const auto [a, b] = share(0, nsrow, t, nt);
-    for (int i = a; i < b; ++i) u[i] = i < nscol ? y[k1 + i] : Real(0);
+    const auto [lo, hi] = share(0, b.nsrow, t, nt);
+    for (int i = lo; i < hi; ++i) u[i] = i < b.nscol ? y[b.k1 + i] : Real(0);
   }
   barrier();
-  for (int j0 = 0; j0 < nscol; j0 += kSharedBlock) {
-    const int j1 = std::min(j0 + kSharedBlock, nscol);
+  for (int j0 = 0; j0 < b.nscol; j0 += kSharedBlock) {
+    const int j1 = std::min(j0 + kSharedBlock, b.nscol);
     if (t == 0)
       for (int j = j0; j < j1; ++j) {
-        const Real* col = trapezoid_column(Ls, nsrow, j);
+        const Real* col = trapezoid_column(b.L, b.nsrow, j);
         const Real xj = (u[j] /= col[j]);
         for (int i = j + 1; i < j1; ++i) u[i] -= col[i] * xj;
       }
     barrier();
-    const auto [a, b] = share(j1, nsrow, t, nt);
-    int j = j0;
-    for (; j + 4 <= j1; j += 4) {
-      const Real* c0 = trapezoid_column(Ls, nsrow, j);
-      const Real* c1 = trapezoid_column(Ls, nsrow, j + 1);
-      const Real* c2 = trapezoid_column(Ls, nsrow, j + 2);
-      const Real* c3 = trapezoid_column(Ls, nsrow, j + 3);
-      const Real x0 = u[j], x1 = u[j + 1], x2 = u[j + 2], x3 = u[j + 3];
-      for (int i = a; i < b; ++i) u[i] -= (c0[i] * x0 + c1[i] * x1) + (c2[i] * x2 + c3[i] * x3);
-    }
-    for (; j < j1; ++j) {
-      const Real* col = trapezoid_column(Ls, nsrow, j);
-      const Real xj = u[j];
-      for (int i = a; i < b; ++i) u[i] -= col[i] * xj;
-    }
+    const auto [lo, hi] = share(j1, b.nsrow, t, nt);
+    subtract_columns(b.L, b.nsrow, j0, j1, u, lo, u + lo, hi - lo);
     barrier();
   }
-  const auto [a, b] = share(0, nsrow, t, nt);
-  for (int i = a; i < b; ++i) {  // the rows below belong to no other supernode of the top phase
-    if (i < nscol)
-      y[k1 + i] = u[i];
+  const auto [lo, hi] = share(0, b.nsrow, t, nt);
+  for (int i = lo; i < hi; ++i) {  // the rows below belong to no other supernode of the top phase
+    if (i < b.nscol)
+      y[b.k1 + i] = u[i];
     else
-      y[r[i - nscol]] += u[i];  // u holds minus the update
+      y[b.rows[i - b.nscol]] += u[i];  // u holds minus the update
   }
   barrier();
 }
@@ -294,31 +286,29 @@ void ParallelSubstitution::forward_shared(const Real* values, Workspace<Real>& w
 // the threads by columns, then the block's triangle on thread 0.
 template <class Real>
 void ParallelSubstitution::backward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt) {
-  const int k1 = L_.super[s], nscol = L_.super[s + 1] - k1, nsrow = L_.pi[s + 1] - L_.pi[s];
-  const int* r = L_.rows + L_.pi[s] + nscol;
-  const Real* Ls = values + L_.start[s];
+  const Block<Real> b = block(values, s);
   Real* y = ws.y.data();
   Real* u = ws.work[0].data();
   {
-    const auto [a, b] = share(0, nsrow, t, nt);
-    for (int i = a; i < b; ++i) u[i] = i < nscol ? y[k1 + i] : y[r[i - nscol]];
+    const auto [lo, hi] = share(0, b.nsrow, t, nt);
+    for (int i = lo; i < hi; ++i) u[i] = i < b.nscol ? y[b.k1 + i] : y[b.rows[i - b.nscol]];
   }
   barrier();
-  for (int j1 = nscol; j1 > 0;) {
+  for (int j1 = b.nscol; j1 > 0;) {
     const int j0 = std::max(0, j1 - kSharedBlock);
-    const auto [a, b] = share(j0, j1, t, nt);
-    for (int j = a; j < b; ++j) u[j] -= dot(trapezoid_column(Ls, nsrow, j) + j1, u + j1, nsrow - j1);
+    const auto [lo, hi] = share(j0, j1, t, nt);
+    for (int j = lo; j < hi; ++j) u[j] -= dot(trapezoid_column(b.L, b.nsrow, j) + j1, u + j1, b.nsrow - j1);
     barrier();
     if (t == 0)
       for (int j = j1 - 1; j >= j0; --j) {
-        const Real* col = trapezoid_column(Ls, nsrow, j);
+        const Real* col = trapezoid_column(b.L, b.nsrow, j);
         u[j] = (u[j] - dot(col + j + 1, u + j + 1, j1 - j - 1)) / col[j];
       }
     barrier();
     j1 = j0;
   }
-  const auto [a, b] = share(0, nscol, t, nt);
-  for (int i = a; i < b; ++i) y[k1 + i] = u[i];
+  const auto [lo, hi] = share(0, b.nscol, t, nt);
+  for (int i = lo; i < hi; ++i) y[b.k1 + i] = u[i];
   barrier();
 }
 

@@ -55,6 +55,20 @@ class ParallelSubstitution {
     std::vector<std::vector<Real>> acc, work;
     std::vector<Real> y;
   };
+  // Supernode s: its first column k1, its nscol columns and nsrow rows, the rows below its
+  // diagonal block, and its values.
+  template <class Real>
+  struct Block {
+    int k1, nscol, nsrow;
+    const int* rows;
+    const Real* L;
+  };
+  template <class Real>
+  Block<Real> block(const Real* values, int s) const {
+    const int k1 = L_.super[s];
+    return {k1, L_.super[s + 1] - k1, L_.pi[s + 1] - L_.pi[s], L_.rows + L_.pi[s] + (L_.super[s + 1] - k1),
+            values + L_.start[s]};
+  }
   template <class Real>
   void forward(const Real* values, Workspace<Real>& ws, int s, Real* acc, Real* w);
   template <class Real>

@@ -54,7 +54,9 @@ TEST(ParallelSubstitution, SolvesTheSystemSeriallyAndOnTwoThreads) {
       omp_set_num_threads(before);
 #endif
       EXPECT_LT(solver.parallel_top_fraction(), 1.0);  // some work was split between threads
-      if (n == 3000) EXPECT_GT(solver.shared_top_supernodes(), 0);  // and the root separator too
+      if (n == 3000) {
+        EXPECT_GT(solver.shared_top_supernodes(), 0);  // and the root separator too
+      }
       // Double: backward stable. Float: the factor's rounding, about 6e-8 relative, times the
       // growth of the substitution.
       EXPECT_LT(relative_residual(e.system(), b, serial), single ? 1e-5 : 1e-13) << n;

@@ -13,6 +13,7 @@
 
 #include "flow_engine.hpp"
 #include "yade_force_bridge.hpp"
+#include "yade_sphere_pack.hpp"
 
 namespace py = pybind11;
 using namespace pfv;
@@ -106,6 +107,11 @@ PYBIND11_MODULE(_core, m) {
       .def("apply", &YadeForceBridge::apply, py::arg("add"), py::arg("forces"))
       .def_property_readonly("writes_in_place", &YadeForceBridge::writes_in_place)
       .def("__len__", &YadeForceBridge::size);
+
+  // The sphere centres from a yade.pack.SpherePack after fromSimulation() (yade_sphere_pack.hpp).
+  m.def("sphere_pack_size", [](py::handle pack) { return sphere_pack_size(pack); }, py::arg("pack"));
+  m.def("gather_sphere_pack", &gather_sphere_pack, py::arg("pack"), py::arg("index"), py::arg("centres"),
+        py::arg("radii") = py::none());
 
   // One axis of the sphere centres straight from YADE's coordinate list for that axis
   // (yade._utils.coordsAndDisplacements(axis)[0], all bodies): no numpy round trip. One axis at

@@ -20,8 +20,10 @@ import numpy as np
 import yade
 from yade.wrapper import PyRunner, Sphere, Box
 from yade.minieigenHP import Vector3
+from yade._packSpheres import SpherePack
 
-from ._core import Engine, YadeForceBridge, gather_axis, set_num_threads
+from ._core import (Engine, YadeForceBridge, gather_axis, gather_sphere_pack, set_num_threads,
+                    sphere_pack_size)
 from ._yade_api import ATTRIBUTES as _YADE_ATTRIBUTES, METHODS as _YADE_METHODS
 
 __all__ = ["FlowEngine", "TimeStepWarning"]
@@ -67,6 +69,7 @@ _INTERNAL = frozenset({
     "_boundary_use_max_min", "_wall_ids", "_warned", "_vertex_of_id", "_threads",
     "_mass_per_diameter", "_dt_dem", "_masses", "_dt_collective", "_collective_viscosity",
     "_collective_mesh", "_collective_mode", "_collective_history", "_dt_unsafe", "_force_bridge",
+    "_n_listed", "_pack", "_pack_index", "_pack_size", "_use_sphere_pack",
     "time_step_safety", "strict_time_step", "collective_iterations", "collective_iterations_warm",
 })
 # YADE attributes PFV implements through a core attribute of another name (the others are
@@ -108,6 +111,8 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_warned", set())
         object.__setattr__(self, "_ids", None)
         object.__setattr__(self, "_force_bridge", None)
+        object.__setattr__(self, "_pack", None)  # a SpherePack whose array this build reads, or None
+        object.__setattr__(self, "_use_sphere_pack", True)  # False: always the coordinate lists
         object.__setattr__(self, "_threads", None)  # None: follow YADE's -j
         object.__setattr__(self, "_mass_per_diameter", float("inf"))
         object.__setattr__(self, "_dt_dem", float("inf"))
@@ -222,16 +227,20 @@ class FlowEngine(PyRunner):
         if O.periodic:
             raise NotImplementedError("pfv.FlowEngine does not support periodic scenes yet")
         ids, radii, rows, masses, others, clumps = [], [], [], [], 0, 0
+        pack_index, pack_size = [], 0  # SpherePack.fromSimulation() lists every sphere body in id order
         mass_per_diameter = float("inf")  # min m/d over the dynamic coupled spheres
         row_of = {}
         wall_set = set(self._wall_ids)
         for row, b in enumerate(O.bodies):
             row_of[b.id] = row
+            is_sphere = isinstance(b.shape, Sphere) and not b.isClump
+            pack_size += is_sphere
             if b.id in wall_set:
                 continue
             if b.isClump or b.isClumpMember:
                 clumps += 1
-            elif isinstance(b.shape, Sphere):
+            elif is_sphere:
+                pack_index.append(pack_size - 1)
                 ids.append(b.id)
                 radii.append(b.shape.radius)
                 rows.append(row)
@@ -270,6 +279,7 @@ class FlowEngine(PyRunner):
         object.__setattr__(self, "_wall_rows", wall_rows)
         object.__setattr__(self, "_wall_half", wall_half)
         object.__setattr__(self, "_n_bodies", len(O.bodies))
+        object.__setattr__(self, "_n_listed", len(row_of))
         object.__setattr__(self, "_vertex_of_id", vertex_of_id)
         object.__setattr__(self, "_mass_per_diameter", mass_per_diameter)
         object.__setattr__(self, "_masses", np.array(masses, dtype=float))
@@ -282,18 +292,61 @@ class FlowEngine(PyRunner):
             object.__setattr__(self, "_force_bridge", (key, bridge))
         dem = yade.utils.PWaveTimeStep() if ids else float("inf")
         object.__setattr__(self, "_dt_dem", dem if dem > 0 else float("inf"))
+        self._choose_position_reader(np.array(pack_index, dtype=np.int64), pack_size)
+
+    def _choose_position_reader(self, pack_index, pack_size):
+        """Read the centres from a SpherePack (yade_sphere_pack.hpp) if this YADE's pack gives,
+        for every sphere, the centre and radius YADE's Python interface gives, bit for bit."""
+        object.__setattr__(self, "_pack", None)
+        if not self._use_sphere_pack:
+            return
+        pack = SpherePack()
+        pack.fromSimulation()
+        if sphere_pack_size(pack) != pack_size:
+            return
+        centres, radii = np.empty((len(pack_index), 3)), np.empty(len(pack_index))
+        gather_sphere_pack(pack, pack_index, centres, radii)
+        listed = self._read_positions()
+        if listed is not None and np.array_equal(centres, listed[0]) and np.array_equal(radii, self._radii):
+            object.__setattr__(self, "_pack_index", pack_index)
+            object.__setattr__(self, "_pack_size", pack_size)
+            object.__setattr__(self, "_pack", pack)
+
+    @property
+    def position_source(self):
+        """Where the sphere centres come from each step: "SpherePack" (YADE's C++ copy of the
+        bodies' centres, read in place) or "coordinate lists" (yade._utils.coordsAndDisplacements,
+        one Python list per axis; used when the pack's layout does not check out)."""
+        return "SpherePack" if self._pack is not None else "coordinate lists"
 
     def _read_positions(self):
-        """Sphere centres (n, 3) and the six boundary coordinates, one YADE list per axis."""
+        """Sphere centres (n, 3) and the six boundary coordinates, or None if bodies were erased
+        since the last scan."""
         pos = np.empty((len(self._rows), 3))
         walls = [0.0] * 6
-        for axis in range(3):
-            coords = _coordinates(axis)[0]
-            gather_axis(coords, self._rows, pos, axis)
-            for w in (2 * axis, 2 * axis + 1):
+        if self._pack is not None:
+            pack = self._pack
+            pack.fromSimulation()
+            if sphere_pack_size(pack) != self._pack_size:
+                return None
+            gather_sphere_pack(pack, self._pack_index, pos)
+            bodies = yade.O.bodies
+            for w in range(6):
                 if not self._boundary_use_max_min[w]:
-                    walls[w] = coords[self._wall_rows[w]] + self._wall_half[w]
-            del coords  # one list alive at a time
+                    wall = bodies[self._wall_ids[w]]
+                    if wall is None:
+                        return None
+                    walls[w] = wall.state.pos[w // 2] + self._wall_half[w]
+        else:
+            for axis in range(3):
+                coords = _coordinates(axis)[0]
+                if len(coords) != self._n_listed:
+                    return None
+                gather_axis(coords, self._rows, pos, axis)
+                for w in (2 * axis, 2 * axis + 1):
+                    if not self._boundary_use_max_min[w]:
+                        walls[w] = coords[self._wall_rows[w]] + self._wall_half[w]
+                del coords  # one list alive at a time
         for w in range(6):
             if self._boundary_use_max_min[w]:
                 axis = w // 2
@@ -308,10 +361,14 @@ class FlowEngine(PyRunner):
             self._scan_bodies()  # radii and masses may have changed too
             if bodies_changed:
                 core.request_remesh()
+        read = self._read_positions()
+        if read is None:  # bodies erased (which leaves len(O.bodies) as it was)
+            self._scan_bodies()
+            core.request_remesh()
+            read = self._read_positions()
+        pos, walls = read
         set_num_threads(self._threads or O.numThreads)
         self._check_time_step(O.dt)
-        # One list per axis over all bodies (YADE's cheapest bulk read), gathered in C++.
-        pos, walls = self._read_positions()
         remeshing = core.remesh_due()
         try:
             core.step(pos, self._radii, walls, O.dt)

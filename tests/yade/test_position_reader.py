@@ -1,0 +1,107 @@
+"""The two ways pfv.FlowEngine reads the sphere centres give the same simulation, bit for bit.
+
+    yade-double -n -x tests/yade/test_position_reader.py        (exit 0 = pass)
+
+pfv reads the centres each step from a yade.pack.SpherePack filled by YADE's C++ fromSimulation()
+(yade_sphere_pack.hpp), after checking at each scan of the bodies that the pack gives every
+centre and radius YADE's Python interface gives; otherwise from the coordinate lists of
+yade._utils.coordsAndDisplacements. On a permeameter whose spheres move under the drag, both
+readers must give identical pressures and forces at every step, also across the erasure of a
+sphere (which leaves len(O.bodies) unchanged: the engine must notice it by the count of what it
+reads, rescan and remesh). The low-level functions must reject what they cannot read.
+"""
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
+import scenes  # noqa: E402
+from yade import O  # noqa: E402
+from yade.wrapper import Sphere  # noqa: E402
+from yade._packSpheres import SpherePack  # noqa: E402
+from pfv import FlowEngine, _core  # noqa: E402
+
+failures = []
+
+
+def check(ok, text):
+    print(("ok   " if ok else "FAIL ") + text)
+    if not ok:
+        failures.append(text)
+
+
+STEPS, ERASE_AT = 12, 6
+info = scenes.build_permeameter(num=1000, frozen=False)
+victim = info["spheres"][len(info["spheres"]) // 2]
+O.saveTmp("reader")
+
+
+def run(use_pack):
+    O.loadTmp("reader")
+    flow = FlowEngine()
+    scenes.configure_flow(flow, axis=1, dp=1.0e3, useSolver=3, meshUpdateInterval=1000000, defTolerance=0)
+    object.__setattr__(flow, "_use_sphere_pack", use_pack)
+    scenes.insert_flow(flow)
+    start = np.array([tuple(b.state.pos) for b in O.bodies if isinstance(b.shape, Sphere)])
+    steps = []
+    for k in range(STEPS):
+        if k == ERASE_AT:
+            O.bodies.erase(victim)
+        O.run(1, True)
+        steps.append(dict(p=np.array(flow.core.pressure()), f=np.array(flow.core.forces()),
+                          remeshes=flow.core.remesh_count, spheres=len(flow._ids)))
+    centres = flow._read_positions()[0]
+    python = np.array([tuple(O.bodies[int(i)].state.pos) for i in flow._ids])
+    moved = np.abs(python[:ERASE_AT] - start[:ERASE_AT]).max()
+    return dict(flow=flow, source=flow.position_source, steps=steps, centres=centres, python=python,
+                moved=moved, ids=list(flow._ids))
+
+
+check(_core.sphere_pack_size(SpherePack()) == 0,
+      "this build reads YADE's SpherePack (Boost.Python found and the layout recognised)")
+fast, lists = run(True), run(False)
+check(fast["source"] == "SpherePack", f"default reader: {fast['source']}")
+check(lists["source"] == "coordinate lists", f"reader with the pack switched off: {lists['source']}")
+check(fast["moved"] > 1e-9, f"the spheres move under the drag (largest displacement {fast['moved']:.3g})")
+for name, run_ in (("SpherePack", fast), ("coordinate lists", lists)):
+    check(np.array_equal(run_["centres"], run_["python"]),
+          f"{name}: every centre read equals b.state.pos after the run")
+    before, after = run_["steps"][ERASE_AT - 1], run_["steps"][ERASE_AT]
+    check(after["remeshes"] == before["remeshes"] + 1 and after["spheres"] == before["spheres"] - 1,
+          f"{name}: erasing sphere #{victim} (len(O.bodies) unchanged) -> rescan and remesh "
+          f"({before['spheres']} -> {after['spheres']} spheres, remesh {before['remeshes']} -> {after['remeshes']})")
+    check(victim not in run_["ids"], f"{name}: the erased sphere is out of the flow")
+same = all(np.array_equal(a["p"], b["p"]) and np.array_equal(a["f"], b["f"])
+           for a, b in zip(fast["steps"], lists["steps"]))
+check(same, f"pressures and forces identical to the bit at all {STEPS} steps of both readers")
+
+# The low-level functions refuse what they cannot read.
+check(_core.sphere_pack_size(O.forces) == -1 and _core.sphere_pack_size(3.0) == -1,
+      "sphere_pack_size is -1 for objects that are no SpherePack")
+pack = SpherePack()
+pack.fromSimulation()
+n = _core.sphere_pack_size(pack)
+
+
+def raises(kind, action):
+    """The message of the `kind` exception action() raises, None if it raises none (others propagate)."""
+    try:
+        action()
+    except kind as error:
+        return str(error)
+    return None
+
+
+message = raises(ValueError, lambda: _core.gather_sphere_pack(O.forces, np.arange(2), np.empty((2, 3))))
+check(message is not None and "SpherePack" in message, f"gather from a non-pack: ValueError ({message})")
+message = raises(IndexError, lambda: _core.gather_sphere_pack(pack, np.array([n]), np.empty((1, 3))))
+check(message is not None and "outside the pack" in message, f"index beyond the pack: IndexError ({message})")
+message = raises(ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(3), np.empty((2, 3))))
+check(message is not None and "shape" in message, f"centres of the wrong shape: ValueError ({message})")
+message = raises(ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(2), np.empty((2, 3)),
+                                                                np.empty(2, dtype=np.float32)))
+check(message is not None and "radii" in message, f"radii not float64: ValueError ({message})")
+
+print(f"{len(failures)} failed")
+sys.exit(1 if failures else 0)

@@ -10,7 +10,8 @@ doc/model.md ("Solving G p = b"), on the cached benchmark packing (made by bench
    in cache and evicted before every solve, refinement passes, contraction estimate, largest pressure difference /
    max|p|;
 3. force write to YADE: the engine's bridge (Vector3 written in place) against addF with tuples from Python;
-4. positions read: coordsAndDisplacements for the three axes with the lists alive together, and one at a time;
+4. positions read: coordsAndDisplacements for the three axes with the lists alive together, and one at a time,
+   against SpherePack.fromSimulation() plus the engine's in-place read of the pack (gather_sphere_pack);
 5. successive forced remeshes of one pfv.FlowEngine on the settled permeameter scene of bench/flow_benchmark.py (the
    benchmark's "remesh" is the second mesh of an engine): C++ stage times per remesh, and the factorisation with
    CHOLMOD's own OpenMP teams (4 threads, its compiled-in CHOLMOD_OMP_NUM_THREADS) against the engine's default, which
@@ -33,6 +34,7 @@ import pfv  # noqa: E402
 import yade  # noqa: E402
 from yade import O, utils  # noqa: E402
 from yade.minieigenHP import Vector3  # noqa: E402
+from yade._packSpheres import SpherePack  # noqa: E402
 
 
 def option(name, default):
@@ -144,7 +146,18 @@ def exchange(pos, rad, L):
             c = read(axis)[0]
             del c
         apart.append(time.perf_counter() - t0)
+    pack = SpherePack()
+    index = np.arange(len(pos), dtype=np.int64)
+    centres = np.empty((len(pos), 3))
+    fill, packed = [], []
+    for k in range(10):
+        t0 = time.perf_counter()
+        pack.fromSimulation()
+        fill.append(time.perf_counter() - t0)
+        pfv._core.gather_sphere_pack(pack, index, centres)
+        packed.append(time.perf_counter() - t0)
     print('   three lists alive together: %s; one axis at a time: %s' % (stats(together), stats(apart)))
+    print('   SpherePack.fromSimulation(): %s; with the in-place read of its centres: %s' % (stats(fill), stats(packed)))
 
 
 def remesh_sequence(n):

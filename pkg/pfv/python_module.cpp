@@ -106,6 +106,7 @@ PYBIND11_MODULE(_core, m) {
            py::arg("vector3_type"), py::arg("ids"), py::arg("rows"))
       .def("apply", &YadeForceBridge::apply, py::arg("add"), py::arg("forces"))
       .def_property_readonly("writes_in_place", &YadeForceBridge::writes_in_place)
+      .def_property_readonly("calls_yade_directly", &YadeForceBridge::calls_yade_directly)
       .def("__len__", &YadeForceBridge::size);
 
   // The sphere centres from a yade.pack.SpherePack after fromSimulation() (yade_sphere_pack.hpp).

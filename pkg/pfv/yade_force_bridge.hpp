@@ -1,16 +1,19 @@
-// Hands the fluid forces to YADE: one O.forces.addF(id, force) per body each step, the
-// cheapest write YADE's Python interface offers (it has no bulk setter).
+// Hands the fluid forces to YADE: O.forces.addF(id, force) for every body each step (YADE's
+// Python interface has no bulk setter).
 //
-// addF with a ready-made Vector3 costs about half of addF with a tuple (bridge measurements in
-// doc/yade-bridge.md), so the bridge owns one YADE Vector3 per body, made once, and writes the
-// force straight into its storage; addF copies the value. The storage is found through
-// Boost.Python's converter registry, which YADE's own bindings populate (so this works only
-// inside a YADE process and only when PFV was built with Boost.Python); failing that, the
-// bridge passes tuples.
+// Most of an addF call is Boost.Python's argument conversion, so the bridge calls the C++
+// function addF is bound to, yade::pyForceContainer::force_add(id, f, permanent=false), itself:
+// the symbol is exported by YADE's wrapper module and found by its mangled name (which spells
+// out the argument types), and the container is the object behind the bound method, found
+// through Boost.Python's converter registry, which YADE's bindings populate. Same function, same
+// arguments as addF, about a fifth of the cost (doc/yade-bridge.md). Failing that (another
+// YADE, PFV built without Boost.Python), one addF call per body with a YADE Vector3 owned by the
+// bridge and written in place (half the cost of a tuple), or with tuples.
 #pragma once
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <memory>
 #include <vector>
 
 namespace pfv {
@@ -25,9 +28,18 @@ class YadeForceBridge {
   // add(ids[i], forces[rows[i]]) for every i; add is a bound O.forces.addF.
   void apply(pybind11::handle add, const Forces& forces) const;
   bool writes_in_place() const { return !storage_.empty(); }
+  // Whether apply(O.forces.addF, ...) calls YADE's force_add directly.
+  bool calls_yade_directly() const { return force_add_ != nullptr; }
   std::size_t size() const { return ids_.size(); }
 
  private:
+  using ForceAdd = void (*)(void* container, long id, const double (&f)[3], bool permanent);
+  // The target of a bound O.forces.addF, or nullptr if it cannot be called directly.
+  void* direct_target(pybind11::handle add) const;
+
+  std::unique_ptr<void, int (*)(void*)> wrapper_module_{nullptr, nullptr};  // dlopen handle
+  ForceAdd force_add_ = nullptr;
+  std::vector<long> id_values_;
   std::vector<pybind11::object> ids_, vectors_;
   std::vector<pybind11::ssize_t> rows_;
   std::vector<double*> storage_;  // x, y, z of vectors_[i]; empty: pass tuples

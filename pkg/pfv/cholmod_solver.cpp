@@ -9,11 +9,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <new>
 #include <stdexcept>
 #include <string>
 
-#include "huge_page_buffer.hpp"
 #include "pressure_system.hpp"
 #include "serial_openmp.hpp"
 
@@ -44,7 +42,6 @@ void CholmodSolver::release() {
   factor_ = nullptr;
   values32_ = nullptr;
   parallel_ = ParallelSubstitution{};  // it points into the factor just freed
-  values_ = HugePageBuffer{};
 }
 
 double CholmodSolver::factor_nonzeros() const {
@@ -190,9 +187,7 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
 void CholmodSolver::promote_to_double(const PressureSystem& s) {
   if (!factor_ || !single_precision()) return;
   values32_ = nullptr;
-  parallel_ = ParallelSubstitution{};
-  values_ = HugePageBuffer{};
-  numeric_factorization(s);  // on the symbolic factor kept from the analysis; rewrites CHOLMOD's array
+  numeric_factorization(s);  // on the symbolic factor kept from the analysis; overwrites the rounded values
   plan_substitution();
 }
 
@@ -201,63 +196,28 @@ namespace {
 // CHOLMOD stores supernode s as a full nsrow x nscol column-major block whose strict upper
 // triangle is never used. The substitutions stream every stored byte, and on a pore network
 // most supernodes are narrow (at 10 000 spheres the unused triangles are 18 % of the entries,
-// and cache lines hold parts of them even when a kernel skips them), so each block is moved to
-// its lower trapezoid: column j keeps rows j..nsrow-1.
-long trapezoid_entries(const cholmod_factor& f) {
-  const auto* super = static_cast<const int*>(f.super);
-  const auto* pi = static_cast<const int*>(f.pi);
-  long entries = 0;
-  for (std::size_t s = 0; s < f.nsuper; ++s) {
-    const long nscol = super[s + 1] - super[s], nsrow = pi[s + 1] - pi[s];
-    entries += nscol * nsrow - nscol * (nscol - 1) / 2;
-  }
-  return entries;
-}
-
-// Moves the blocks from CHOLMOD's array `from` to `to` (the same array, or a separate one of
-// trapezoid_entries(f) values) and returns where each block starts. Moving within one array:
-// a block never moves to a higher address, so copying in increasing order only overwrites
-// entries already moved. Copying to another array: the pages of `from` already copied go back
-// to the kernel as the copy proceeds, so the two arrays are never both whole in memory.
+// and cache lines hold parts of them even when a kernel skips them), so each block is moved,
+// in place, to its lower trapezoid: column j keeps rows j..nsrow-1. Returns where each block
+// now starts. A block never moves to a higher address, so copying in increasing order only
+// overwrites entries already moved.
 template <class Real>
-std::vector<long> compact_to_trapezoids(Real* from, Real* to, const cholmod_factor& f) {
-  constexpr std::ptrdiff_t kReleaseEvery = (std::ptrdiff_t{1} << 21) / sizeof(Real);
+std::vector<long> compact_to_trapezoids(Real* v, const cholmod_factor& f) {
   const auto* super = static_cast<const int*>(f.super);
   const auto* pi = static_cast<const int*>(f.pi);
   const auto* px = static_cast<const int*>(f.px);
   std::vector<long> start(f.nsuper + 1);
   long out = 0;
-  Real* released = from;
   for (std::size_t s = 0; s < f.nsuper; ++s) {
     start[s] = out;
     const long nscol = super[s + 1] - super[s], nsrow = pi[s + 1] - pi[s];
     for (long j = 0; j < nscol; ++j) {
-      const Real* column = from + px[s] + j * nsrow + j;
-      if (to + out != column) std::memmove(to + out, column, (nsrow - j) * sizeof(Real));
+      const Real* from = v + px[s] + j * nsrow + j;
+      if (v + out != from) std::memmove(v + out, from, (nsrow - j) * sizeof(Real));
       out += nsrow - j;
-    }
-    if (to != from && from + px[s + 1] - released >= kReleaseEvery) {
-      release_pages(released, from + px[s + 1]);
-      released = from + px[s + 1];
     }
   }
   start[f.nsuper] = out;
   return start;
-}
-
-// The compacted values in their own array backed by huge pages (huge_page_buffer.hpp), from
-// CHOLMOD's array `from`; in place if that array cannot be had.
-template <class Real>
-Real* compact_into_huge_pages(Real* from, const cholmod_factor& f, HugePageBuffer& values,
-                              std::vector<long>& start) {
-  try {
-    values = HugePageBuffer(static_cast<std::size_t>(trapezoid_entries(f)) * sizeof(Real));
-  } catch (const std::bad_alloc&) {
-    values = HugePageBuffer{};
-  }
-  Real* to = values.data() ? static_cast<Real*>(values.data()) : from;
-  start = compact_to_trapezoids(from, to, f);
-  return to;
 }
 
 }  // namespace
@@ -275,13 +235,15 @@ void CholmodSolver::plan_substitution() {
   view.pi = static_cast<const int*>(f->pi);
   view.rows = static_cast<const int*>(f->s);
   view.perm = static_cast<const int*>(f->Perm);
-  // From here on CHOLMOD's routines must not read the values (solve_serial never calls them);
-  // a new numeric factorisation rewrites CHOLMOD's array whole.
+  // From here on CHOLMOD's routines must not read the values (solve_serial never calls them).
   if (single_precision()) {
-    values32_ = compact_into_huge_pages(const_cast<float*>(values32_), *f, values_, trapezoid_start_);
-    view.values32 = values32_;
+    auto* v = const_cast<float*>(values32_);
+    trapezoid_start_ = compact_to_trapezoids(v, *f);
+    view.values32 = v;
   } else {
-    view.values = compact_into_huge_pages(static_cast<double*>(f->x), *f, values_, trapezoid_start_);
+    auto* v = static_cast<double*>(f->x);
+    trapezoid_start_ = compact_to_trapezoids(v, *f);
+    view.values = v;
   }
   view.start = trapezoid_start_.data();
   parallel_.plan(view, 2);

@@ -4,7 +4,6 @@
 #pragma once
 #include <vector>
 
-#include "huge_page_buffer.hpp"
 #include "parallel_substitution.hpp"
 
 namespace pfv {
@@ -80,9 +79,8 @@ class CholmodSolver {
   Common* common_;
   bool openmp_teams_ = false;
   void* factor_ = nullptr;  // cholmod_factor*
-  HugePageBuffer values_;  // the compacted values; empty: they are in CHOLMOD's array
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
-  const float* values32_ = nullptr;  // the factor's values rounded to float; or null
+  const float* values32_ = nullptr;  // the factor's values rounded, in CHOLMOD's array; or null
   ParallelSubstitution parallel_;
   bool metis_used_ = false;
   bool ordering_given_ = false;

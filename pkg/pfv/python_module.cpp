@@ -112,7 +112,7 @@ PYBIND11_MODULE(_core, m) {
   // The sphere centres from a yade.pack.SpherePack after fromSimulation() (yade_sphere_pack.hpp).
   m.def("sphere_pack_size", [](py::handle pack) { return sphere_pack_size(pack); }, py::arg("pack"));
   m.def("gather_sphere_pack", &gather_sphere_pack, py::arg("pack"), py::arg("index"), py::arg("centres"),
-        py::arg("radii") = py::none());
+        py::arg("radii") = py::none(), py::arg("expected_size") = -1);
 
   // One axis of the sphere centres straight from YADE's coordinate list for that axis
   // (yade._utils.coordsAndDisplacements(axis)[0], all bodies): no numpy round trip. One axis at

@@ -55,10 +55,12 @@ long long sphere_pack_size(py::handle pack) {
   return spheres ? static_cast<long long>(spheres->size()) : -1;
 }
 
-void gather_sphere_pack(py::handle pack, const py::array_t<long long>& index, py::array_t<double>& centres,
-                        py::object radii) {
+bool gather_sphere_pack(py::handle pack, const py::array_t<long long>& index, py::array_t<double>& centres,
+                        py::object radii, long long expected_size) {
   const auto* spheres = spheres_of(pack);
   if (!spheres) throw py::value_error("gather_sphere_pack: not a SpherePack this build of pfv can read");
+  const auto n = static_cast<long long>(spheres->size());
+  if (expected_size >= 0 && n != expected_size) return false;
   const auto k = index.unchecked<1>();
   if (centres.ndim() != 2 || centres.shape(0) != k.shape(0) || centres.shape(1) != 3)
     throw py::value_error("gather_sphere_pack: centres must have shape (len(index), 3)");
@@ -71,7 +73,6 @@ void gather_sphere_pack(py::handle pack, const py::array_t<long long>& index, py
       throw py::value_error("gather_sphere_pack: radii must be a writeable float64 array of len(index)");
     r = static_cast<double*>(a.mutable_data());
   }
-  const auto n = static_cast<long long>(spheres->size());
   const PackedSphere* s = spheres->data();
   for (py::ssize_t i = 0; i < k.shape(0); ++i) {
     const long long j = k(i);
@@ -79,6 +80,7 @@ void gather_sphere_pack(py::handle pack, const py::array_t<long long>& index, py
     c(i, 0) = s[j].centre[0], c(i, 1) = s[j].centre[1], c(i, 2) = s[j].centre[2];
     if (r) r[i] = s[j].radius;
   }
+  return true;
 }
 
 }  // namespace pfv

@@ -20,10 +20,11 @@ namespace pfv {
 // (no Boost.Python, another YADE, another object).
 long long sphere_pack_size(pybind11::handle pack);
 
-// centres[i] = centre of pack sphere index[i], radii[i] (if given) its radius.
-// Throws ValueError if the pack cannot be read or the shapes do not match, IndexError if an
-// index is outside the pack.
-void gather_sphere_pack(pybind11::handle pack, const pybind11::array_t<long long>& index,
-                        pybind11::array_t<double>& centres, pybind11::object radii);
+// centres[i] = centre of pack sphere index[i], radii[i] (if given) its radius; returns false,
+// writing nothing, if expected_size >= 0 and the pack holds another number of spheres (bodies
+// were erased or added since the index was made). Throws ValueError if the pack cannot be read
+// or the shapes do not match, IndexError if an index is outside the pack.
+bool gather_sphere_pack(pybind11::handle pack, const pybind11::array_t<long long>& index,
+                        pybind11::array_t<double>& centres, pybind11::object radii, long long expected_size);
 
 }  // namespace pfv

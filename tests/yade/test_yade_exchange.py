@@ -98,6 +98,10 @@ def raises(kind, action):
 
 message = raises(ValueError, lambda: _core.gather_sphere_pack(O.forces, np.arange(2), np.empty((2, 3))))
 check(message is not None and "SpherePack" in message, f"gather from a non-pack: ValueError ({message})")
+out = np.full((2, 3), 7.0)
+check(not _core.gather_sphere_pack(pack, np.arange(2), out, None, n + 1) and (out == 7.0).all()
+      and _core.gather_sphere_pack(pack, np.arange(2), out, None, n) and (out != 7.0).any(),
+      "gather with the wrong expected size returns False and writes nothing; with the right one True")
 message = raises(IndexError, lambda: _core.gather_sphere_pack(pack, np.array([n]), np.empty((1, 3))))
 check(message is not None and "outside the pack" in message, f"index beyond the pack: IndexError ({message})")
 message = raises(ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(3), np.empty((2, 3))))

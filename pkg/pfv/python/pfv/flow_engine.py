@@ -302,10 +302,9 @@ class FlowEngine(PyRunner):
             return
         pack = SpherePack()
         pack.fromSimulation()
-        if sphere_pack_size(pack) != pack_size:
-            return
         centres, radii = np.empty((len(pack_index), 3)), np.empty(len(pack_index))
-        gather_sphere_pack(pack, pack_index, centres, radii)
+        if sphere_pack_size(pack) < 0 or not gather_sphere_pack(pack, pack_index, centres, radii, pack_size):
+            return
         listed = self._read_positions()
         if listed is not None and np.array_equal(centres, listed[0]) and np.array_equal(radii, self._radii):
             object.__setattr__(self, "_pack_index", pack_index)
@@ -327,9 +326,8 @@ class FlowEngine(PyRunner):
         if self._pack is not None:
             pack = self._pack
             pack.fromSimulation()
-            if sphere_pack_size(pack) != self._pack_size:
+            if not gather_sphere_pack(pack, self._pack_index, pos, None, self._pack_size):
                 return None
-            gather_sphere_pack(pack, self._pack_index, pos)
             bodies = yade.O.bodies
             for w in range(6):
                 if not self._boundary_use_max_min[w]:

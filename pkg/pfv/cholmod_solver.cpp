@@ -5,9 +5,10 @@
 #include <omp.h>
 #endif
 
-#include <cfloat>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -40,7 +41,7 @@ void CholmodSolver::release() {
     cholmod_free_factor(&f, c);
   }
   factor_ = nullptr;
-  values32_ = nullptr;
+  std::vector<double>().swap(scale_);
   parallel_ = ParallelSubstitution{};  // it points into the factor just freed
 }
 
@@ -135,30 +136,8 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
   if (!ordering_given_)
     metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
   numeric_factorization(s);
-
-  if (precision == FactorPrecision::kSingle && f->is_super && f->is_ll) {
-    // Round in place, into the first half of CHOLMOD's own array: float i overwrites bytes of
-    // double i/2, which has been read already. No allocation and no fresh pages to fault in
-    // (those cost more than the rounding: 30 ms for the 8e6 entries at 10 000 spheres). The
-    // bytes are copied with memcpy, which is how C++ lets one type's storage hold another's.
-    auto* bytes = static_cast<unsigned char*>(f->x);
-    const std::size_t count = static_cast<const int*>(f->px)[f->nsuper];
-    bool representable = true;
-    for (std::size_t i = 0; i < count; ++i) {
-      double d;
-      std::memcpy(&d, bytes + 8 * i, sizeof d);
-      const float v = static_cast<float>(d);
-      // Overflow, NaN, or a non-zero that float cannot hold normally (subnormal or zero).
-      representable &= std::isfinite(v) & ((d == 0) | (std::abs(v) >= FLT_MIN));
-      std::memcpy(bytes + 4 * i, &v, sizeof v);
-    }
-    if (representable) {
-      values32_ = reinterpret_cast<const float*>(bytes);
-    } else {
-      numeric_factorization(s);  // the doubles were overwritten: factorise again, stay double
-    }
-  }
-  plan_substitution();
+  reduced_ = precision == FactorPrecision::kScaled32;
+  plan_substitution(s);
 }
 
 void CholmodSolver::numeric_factorization(const PressureSystem& s) {
@@ -185,10 +164,11 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
 }
 
 void CholmodSolver::promote_to_double(const PressureSystem& s) {
-  if (!factor_ || !single_precision()) return;
-  values32_ = nullptr;
-  numeric_factorization(s);  // on the symbolic factor kept from the analysis; overwrites the rounded values
-  plan_substitution();
+  if (!factor_ || !reduced_precision()) return;
+  reduced_ = false;
+  std::vector<double>().swap(scale_);
+  numeric_factorization(s);  // on the symbolic factor kept from the analysis; overwrites the 32-bit values
+  plan_substitution(s);
 }
 
 namespace {
@@ -220,9 +200,43 @@ std::vector<long> compact_to_trapezoids(Real* v, const cholmod_factor& f) {
   return start;
 }
 
+// The compacted double values to 32-bit integers scaled per column, in place: integer k
+// overwrites bytes of double k/2, which has been read already (a column is read whole, for
+// its largest entry, before any of its integers is written). No allocation and no fresh pages
+// to fault in (those cost more than the conversion). The bytes go through memcpy, which is how
+// C++ lets one type's storage hold another's. False, with the values destroyed, if a scale is
+// not a normal double.
+bool scale_to_int32(double* v, const cholmod_factor& f, const std::vector<long>& start, std::vector<double>& scale) {
+  const auto* super = static_cast<const int*>(f.super);
+  const auto* pi = static_cast<const int*>(f.pi);
+  auto* bytes = reinterpret_cast<unsigned char*>(v);
+  constexpr double kMax = 2147483647.0;  // 2^31 - 1
+  scale.resize(f.n);
+  bool normal = true;
+  for (std::size_t s = 0; s < f.nsuper; ++s) {
+    const long nscol = super[s + 1] - super[s], nsrow = pi[s + 1] - pi[s];
+    long at = start[s];
+    for (long j = 0; j < nscol; ++j) {
+      const long len = nsrow - j;
+      double largest = 0;
+      for (long i = 0; i < len; ++i) largest = std::max(largest, std::abs(v[at + i]));
+      const double unit = largest / kMax;
+      normal &= std::isnormal(unit);
+      scale[super[s] + j] = unit;
+      for (long i = 0; i < len; ++i) {
+        const double q = std::clamp(std::nearbyint(v[at + i] / unit), -kMax, kMax);
+        const auto k = static_cast<std::int32_t>(normal ? q : 0.0);
+        std::memcpy(bytes + 4 * (at + i), &k, sizeof k);
+      }
+      at += len;
+    }
+  }
+  return normal;
+}
+
 }  // namespace
 
-void CholmodSolver::plan_substitution() {
+void CholmodSolver::plan_substitution(const PressureSystem& system) {
   auto* f = static_cast<cholmod_factor*>(factor_);
   if (!f->is_super || !f->is_ll) {  // CHOLMOD_SUPERNODAL is requested in the constructor
     release();
@@ -236,13 +250,19 @@ void CholmodSolver::plan_substitution() {
   view.rows = static_cast<const int*>(f->s);
   view.perm = static_cast<const int*>(f->Perm);
   // From here on CHOLMOD's routines must not read the values (solve_serial never calls them).
-  if (single_precision()) {
-    auto* v = const_cast<float*>(values32_);
+  auto* v = static_cast<double*>(f->x);
+  trapezoid_start_ = compact_to_trapezoids(v, *f);
+  if (reduced_ && !scale_to_int32(v, *f, trapezoid_start_, scale_)) {
+    std::vector<double>().swap(scale_);  // stay double: factorise again, the values were overwritten
+    reduced_ = false;
+    numeric_factorization(system);
+    v = static_cast<double*>(f->x);
     trapezoid_start_ = compact_to_trapezoids(v, *f);
-    view.values32 = v;
+  }
+  if (reduced_) {
+    view.scaled = reinterpret_cast<const std::int32_t*>(v);
+    view.scale = scale_.data();
   } else {
-    auto* v = static_cast<double*>(f->x);
-    trapezoid_start_ = compact_to_trapezoids(v, *f);
     view.values = v;
   }
   view.start = trapezoid_start_.data();

@@ -21,10 +21,19 @@ struct SupernodalChains {
 // Fill-reducing ordering. kAuto is CHOLMOD's default (AMD, then METIS if AMD fills badly).
 enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
 
-// kSingle keeps the factor, computed in double, rounded to float (in CHOLMOD's array): half
-// the memory traffic of a substitution, whose result is then only an approximate inverse, to
-// be used inside iterative refinement (refinement.hpp).
-enum class FactorPrecision { kDouble, kSingle };
+// kScaled32 keeps the factor, computed in double, as 32-bit integers with one double scale per
+// column (in CHOLMOD's array): L(i, j) ~ q(i, j) * max_i |L(i, j)| / (2^31 - 1). Half the memory
+// traffic of a substitution, whose result is then only an approximate inverse, to be used
+// inside iterative refinement (refinement.hpp). The substitution still computes in double.
+//
+// Why not float: what limits an approximate factor inside refinement is its perturbation
+// relative to each column, and the entries of a column of L are of similar size. Rounding
+// them to float (24 bits relative to each entry) gives a contraction ||I - M^-1 G|| of
+// 2.5e-7 on the 10 000-sphere benchmark system, 32-bit integers relative to the column's
+// largest entry 1.2e-8 (2.7e-7 and 2e-8 at 50 000), for the same four bytes (doc/model.md,
+// "Solving G p = b"). One pass from the previous step's pressures then meets the default
+// tolerance; with float it needs two, and a second pass costs what the double solve saves.
+enum class FactorPrecision { kDouble, kScaled32 };
 
 // An elimination order of the unknowns to try before computing one (ordering_reuse.hpp): kept
 // if its factor has at most max_fill entries per unknown.
@@ -41,15 +50,16 @@ class CholmodSolver {
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
 
-  // Throws std::domain_error if G is not positive definite. A single-precision request falls
-  // back to double when an entry of the factor is out of float's normal range.
+  // Throws std::domain_error if G is not positive definite. A kScaled32 request falls back to
+  // double when a column's scale is not a normal double (never for the pore networks; kept
+  // because the format's error bound assumes it).
   // 'ordering' is computed unless 'given' is accepted.
   void factorize(const PressureSystem& system, Ordering ordering,
                  FactorPrecision precision = FactorPrecision::kDouble, const GivenOrdering& given = {});
   // Refactorises in double on the same ordering (no new analysis): for when refinement with
-  // the rounded factor does not converge (G too ill-conditioned for float).
+  // the 32-bit factor does not converge (G too ill-conditioned for it).
   void promote_to_double(const PressureSystem& system);
-  // x ~ G^-1 rhs; exact to round-off in double, to about cond(G) * 6e-8 in single precision.
+  // x ~ G^-1 rhs; exact to round-off in double, an approximate inverse with kScaled32.
   // Always PFV's own substitution (parallel_substitution.hpp) on the compacted factor, whose
   // values CHOLMOD can no longer read: with two or more OpenMP threads on subtrees in parallel.
   void solve(const std::vector<double>& rhs, std::vector<double>& x);
@@ -57,7 +67,7 @@ class CholmodSolver {
   void set_openmp_teams(bool on) { openmp_teams_ = on; }
   // The same on the calling thread only (the same arithmetic, the same result).
   void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
-  bool single_precision() const { return values32_ != nullptr; }
+  bool reduced_precision() const { return !scale_.empty(); }  // the kScaled32 format
   double parallel_top_fraction() const { return parallel_.top_fraction(); }
   int shared_top_supernodes() const { return parallel_.shared_top_supernodes(); }
   bool metis_used() const { return metis_used_; }
@@ -74,13 +84,14 @@ class CholmodSolver {
   void release();
   void solve_on(const std::vector<double>& rhs, std::vector<double>& x, bool threads);
   void numeric_factorization(const PressureSystem& system);
-  void plan_substitution();
+  void plan_substitution(const PressureSystem& system);
   struct Common;
   Common* common_;
   bool openmp_teams_ = false;
   void* factor_ = nullptr;  // cholmod_factor*
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
-  const float* values32_ = nullptr;  // the factor's values rounded, in CHOLMOD's array; or null
+  bool reduced_ = false;       // kScaled32 asked for (until a fallback to double)
+  std::vector<double> scale_;  // per column (elimination order) with kScaled32; empty in double
   ParallelSubstitution parallel_;
   bool metis_used_ = false;
   bool ordering_given_ = false;

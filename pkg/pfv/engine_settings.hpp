@@ -18,10 +18,10 @@ struct EngineSettings {
   // has at most max_fill_growth times the entries per unknown of the last fresh ordering.
   bool reuse_ordering = true;
   double max_fill_growth = 1.1;
-  // useSolver 3 only: keep the Cholesky factor in single precision and refine each solve in
-  // double from the previous pressures (refinement.hpp) until the estimated error is below
-  // refinement_tolerance * (max p - min p) over the unknowns. Falls back to the double factor if G is too
-  // ill-conditioned for float.
+  // useSolver 3 only: keep the Cholesky factor as 32-bit integers scaled per column
+  // (FactorPrecision::kScaled32) and refine each solve in double from the previous pressures
+  // (refinement.hpp) until the estimated error is below refinement_tolerance * (max p - min p)
+  // over the unknowns. Falls back to the double factor if G is too ill-conditioned for it.
   bool mixed_precision = false;
   double refinement_tolerance = 1e-10;
   int max_refinement_passes = 8;

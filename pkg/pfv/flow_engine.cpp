@@ -48,6 +48,7 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, int bc_version) {
   linear_ = std::move(linear);
   linear_bc_version_ = bc_version;
   pressure_ = std::move(pressure);
+  pressure_before_.clear();  // other cells
   const int nc = mesh_->mesh().n_cells();
   volume_.assign(mesh_->cells.volume.begin(), mesh_->cells.volume.end());
   volume_rate_.assign(nc, 0.0);
@@ -179,9 +180,16 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   } else {
     for (std::size_t i = 0; i < linear_.coupling_k.size(); ++i)
       rhs_[linear_.coupling_unknown[i]] += linear_.coupling_k[i] * next_pressure_[linear_.coupling_cell[i]];
-    if (linear_.cholmod->single_precision()) {
+    if (linear_.cholmod->reduced_precision()) {
+      // Start from the pressures extrapolated from the last two steps: in a smooth motion that
+      // halves the first correction, and with it the error bound that decides whether a second
+      // pass is needed (the bound, not the guess, guarantees the accuracy).
       solution_.resize(nu);
-      for (int u = 0; u < nu; ++u) solution_[u] = next_pressure_[system.unknown_cell[u]];  // warm start
+      const bool trend = pressure_before_.size() == next_pressure_.size();
+      for (int u = 0; u < nu; ++u) {
+        const int c = system.unknown_cell[u];
+        solution_[u] = trend ? 2 * next_pressure_[c] - pressure_before_[c] : next_pressure_[c];
+      }
       if (!linear_.refinement.solve(system, *linear_.cholmod, rhs_, solution_, settings.refinement_tolerance,
                                     settings.max_refinement_passes)) {
         linear_.cholmod->promote_to_double(system);  // G too ill-conditioned for a float factor
@@ -222,6 +230,10 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     if (!next_force_[v].allFinite()) throw std::domain_error("non-finite fluid force on vertex " + std::to_string(v));
 
   std::swap(volume_, next_volume_);
+  if (settings.use_solver == 3 && linear_.cholmod->reduced_precision())
+    std::swap(pressure_before_, pressure_);  // kept for the next start; its buffer becomes scratch
+  else if (!pressure_before_.empty())
+    std::vector<double>().swap(pressure_before_);
   std::swap(pressure_, next_pressure_);
   std::swap(force_, next_force_);
   std::swap(shear_force_, next_shear_);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <type_traits>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -9,42 +10,72 @@
 namespace pfv {
 namespace {
 
+// An entry as a double: 32-bit entries are converted here and scaled by their column's factor
+// by the caller, once per column, not once per entry.
+inline double value(double v) { return v; }
+inline double value(std::int32_t v) { return static_cast<double>(v); }
+
 // Dot product with eight partial sums (vectorises without -ffast-math).
-template <class Real>
-inline Real dot(const Real* a, const Real* b, int n) {
-  Real s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+template <class Stored>
+inline double dot(const Stored* a, const double* b, int n) {
+  double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   int i = 0;
   for (; i + 8 <= n; i += 8)
-    for (int k = 0; k < 8; ++k) s[k] += a[i + k] * b[i + k];
-  for (; i < n; ++i) s[0] += a[i] * b[i];
+    for (int k = 0; k < 8; ++k) s[k] += value(a[i + k]) * b[i + k];
+  for (; i < n; ++i) s[0] += value(a[i]) * b[i];
   return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
 // Column j of a trapezoid block of nsrow rows, indexed by row (entries j..nsrow-1 exist).
-template <class Real>
-inline const Real* trapezoid_column(const Real* block, std::ptrdiff_t nsrow, std::ptrdiff_t j) {
+template <class Stored>
+inline const Stored* trapezoid_column(const Stored* block, std::ptrdiff_t nsrow, std::ptrdiff_t j) {
   return block + j * nsrow - j * (j + 1) / 2;
+}
+
+// The scale of a block's column j: 1 for double entries (a constant the compiler folds).
+template <class Stored>
+inline double column_scale(const double* scale, int j) {
+  if constexpr (std::is_same_v<Stored, double>)
+    return 1.0;
+  else
+    return scale[j];
 }
 
 // u[i] -= sum over columns j in [j0, j1) of L(row0 + i, j) x[j], for i < count, four columns
 // per sweep over u: with one column per sweep the loads and stores of u, not the factor,
-// bound the narrow supernodes. The rows row0.. must lie below column j1 - 1's diagonal.
-template <class Real>
-inline void subtract_columns(const Real* block, int nsrow, int j0, int j1, const Real* x, int row0, Real* u,
+// bound the narrow supernodes. The rows row0.. must lie below column j1 - 1's diagonal. x
+// holds x(j) times column j's scale.
+template <class Stored>
+inline void subtract_columns(const Stored* block, int nsrow, int j0, int j1, const double* x, int row0, double* u,
                              int count) {
   int j = j0;
   for (; j + 4 <= j1; j += 4) {
-    const Real* c0 = trapezoid_column(block, nsrow, j) + row0;
-    const Real* c1 = trapezoid_column(block, nsrow, j + 1) + row0;
-    const Real* c2 = trapezoid_column(block, nsrow, j + 2) + row0;
-    const Real* c3 = trapezoid_column(block, nsrow, j + 3) + row0;
-    const Real x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
-    for (int i = 0; i < count; ++i) u[i] -= (c0[i] * x0 + c1[i] * x1) + (c2[i] * x2 + c3[i] * x3);
+    const Stored* c0 = trapezoid_column(block, nsrow, j) + row0;
+    const Stored* c1 = trapezoid_column(block, nsrow, j + 1) + row0;
+    const Stored* c2 = trapezoid_column(block, nsrow, j + 2) + row0;
+    const Stored* c3 = trapezoid_column(block, nsrow, j + 3) + row0;
+    const double x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
+    for (int i = 0; i < count; ++i)
+      u[i] -= (value(c0[i]) * x0 + value(c1[i]) * x1) + (value(c2[i]) * x2 + value(c3[i]) * x3);
   }
   for (; j < j1; ++j) {
-    const Real* col = trapezoid_column(block, nsrow, j) + row0;
-    const Real xj = x[j];
-    for (int i = 0; i < count; ++i) u[i] -= col[i] * xj;
+    const Stored* col = trapezoid_column(block, nsrow, j) + row0;
+    const double xj = x[j];
+    for (int i = 0; i < count; ++i) u[i] -= value(col[i]) * xj;
+  }
+}
+
+// Columns [j0, j1) of the block's dense triangle, forwards, on u (the block's rows, from row
+// 0): u(j) /= L(j, j), then the rows j+1..j1-1 below it. Leaves u(j) * scale(j) in x.
+template <class Stored>
+inline void solve_triangle(const Stored* block, const double* scale, int nsrow, int j0, int j1, double* u,
+                           double* x) {
+  for (int j = j0; j < j1; ++j) {
+    const Stored* col = trapezoid_column(block, nsrow, j);
+    const double sj = column_scale<Stored>(scale, j);
+    const double xj = (u[j] /= value(col[j]) * sj) * sj;
+    x[j] = xj;
+    for (int i = j + 1; i < j1; ++i) u[i] -= value(col[i]) * xj;
   }
 }
 
@@ -57,8 +88,8 @@ inline void subtract_columns(const Real* block, int nsrow, int j0, int j1, const
 // nothing from the same (tried).
 constexpr std::ptrdiff_t kPrefetchAhead = 2048;
 
-template <class Real>
-inline void prefetch_ahead(const Real* block, const Real* block_end, const Real* values_end) {
+template <class Stored>
+inline void prefetch_ahead(const Stored* block, const Stored* block_end, const Stored* values_end) {
   const char* a = reinterpret_cast<const char*>(block);
   const char* z = reinterpret_cast<const char*>(block_end);
   const char* end = reinterpret_cast<const char*>(values_end);
@@ -173,39 +204,29 @@ void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
   top_fraction_ = total > 0 ? top_entries / total : 1;
   shared_.clear();
   for (int s : top_) shared_.push_back(threads > 1 && f.start[s + 1] - f.start[s] >= kMinSharedEntries);
-  const auto size = [&](auto& ws) {
-    ws.acc.assign(groups_.size(), {});
-    ws.work.assign(groups_.size(), {});
-    for (std::size_t t = 0; t < groups_.size(); ++t) {
-      ws.acc[t].assign(f.n, 0);
-      ws.work[t].assign(max_rows, 0);
-    }
-    ws.y.assign(f.n, 0);
-  };
-  ws64_ = {};
-  ws32_ = {};
-  if (f.values32)
-    size(ws32_);
-  else
-    size(ws64_);
+  const std::size_t buffers = std::max<std::size_t>(groups_.size(), threads);
+  acc_.assign(buffers, std::vector<double>(f.n, 0.0));
+  work_.assign(buffers, std::vector<double>(max_rows, 0.0));
+  scaled_.assign(f.scaled ? buffers : 0, std::vector<double>(max_rows, 0.0));
+  y_.assign(f.n, 0.0);
 }
 
-template <class Real>
-void ParallelSubstitution::forward(const Real* values, Workspace<Real>& ws, int s, Real* acc, Real* w) {
-  const Block<Real> b = block(values, s);
+template <class Stored>
+void ParallelSubstitution::forward(const Stored* values, int s, int thread, bool top) {
+  const Block<Stored> b = block(values, s);
   const int nrest = b.nsrow - b.nscol;
   prefetch_ahead(b.L, values + L_.start[s + 1], values + L_.start[L_.nsuper]);
-  Real* y = ws.y.data() + b.k1;  // this supernode's rows
-  for (int j = 0; j < b.nscol; ++j) {  // the dense triangle
-    const Real* col = trapezoid_column(b.L, b.nsrow, j);
-    const Real xj = (y[j] /= col[j]);
-    for (int i = j + 1; i < b.nscol; ++i) y[i] -= col[i] * xj;
-  }
+  double* y = y_.data() + b.k1;  // this supernode's rows
+  double* x = y;                 // y(j) * scale(j), the same as y for double entries
+  if constexpr (!std::is_same_v<Stored, double>) x = scaled_[thread].data();
+  solve_triangle(b.L, b.scale, b.nsrow, 0, b.nscol, y, x);
   // The rectangle below it: w = -L21 y1.
-  std::fill(w, w + nrest, Real(0));
-  subtract_columns(b.L, b.nsrow, 0, b.nscol, y, b.nscol, w, nrest);
-  Real* all = ws.y.data();
-  if (acc) {  // top rows are shared between threads: collect their updates apart
+  double* w = work_[thread].data();
+  std::fill(w, w + nrest, 0.0);
+  subtract_columns(b.L, b.nsrow, 0, b.nscol, x, b.nscol, w, nrest);
+  double* all = y_.data();
+  if (!top) {  // top rows are shared between threads: collect their updates apart
+    double* acc = acc_[thread].data();
     for (int i = 0; i < nrest; ++i) {
       if (top_row_[b.rows[i]])
         acc[b.rows[i]] -= w[i];
@@ -217,17 +238,19 @@ void ParallelSubstitution::forward(const Real* values, Workspace<Real>& ws, int 
   }
 }
 
-template <class Real>
-void ParallelSubstitution::backward(const Real* values, Workspace<Real>& ws, int s, Real* w) {
-  const Block<Real> b = block(values, s);
+template <class Stored>
+void ParallelSubstitution::backward(const Stored* values, int s, int thread) {
+  const Block<Stored> b = block(values, s);
   const int nrest = b.nsrow - b.nscol;
-  Real* y = ws.y.data();
+  double* y = y_.data();
+  double* w = work_[thread].data();
   for (int i = 0; i < nrest; ++i) w[i] = y[b.rows[i]];
   y += b.k1;
   for (int j = b.nscol - 1; j >= 0; --j) {
-    const Real* col = trapezoid_column(b.L, b.nsrow, j);
-    const Real t = y[j] - dot(col + b.nscol, w, nrest) - dot(col + j + 1, y + j + 1, b.nscol - j - 1);
-    y[j] = t / col[j];
+    const Stored* col = trapezoid_column(b.L, b.nsrow, j);
+    const double sj = column_scale<Stored>(b.scale, j);
+    const double t = y[j] - (dot(col + b.nscol, w, nrest) + dot(col + j + 1, y + j + 1, b.nscol - j - 1)) * sj;
+    y[j] = t / (value(col[j]) * sj);
   }
 }
 
@@ -249,27 +272,24 @@ inline void barrier() {
 // blocks of kSharedBlock columns: the small triangle of a block on thread 0, then the update
 // of all rows below the block split between the threads. Every row sees the same operations
 // in the same order whatever nt is.
-template <class Real>
-void ParallelSubstitution::forward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt) {
-  const Block<Real> b = block(values, s);
-  Real* y = ws.y.data();
-  Real* u = ws.work[0].data();
+template <class Stored>
+void ParallelSubstitution::forward_shared(const Stored* values, int s, int t, int nt) {
+  const Block<Stored> b = block(values, s);
+  double* y = y_.data();
+  double* u = work_[0].data();
+  double* x = u;
+  if constexpr (!std::is_same_v<Stored, double>) x = scaled_[0].data();
   {
     const auto [lo, hi] = share(0, b.nsrow, t, nt);
-    for (int i = lo; i < hi; ++i) u[i] = i < b.nscol ? y[b.k1 + i] : Real(0);
+    for (int i = lo; i < hi; ++i) u[i] = i < b.nscol ? y[b.k1 + i] : 0.0;
   }
   barrier();
   for (int j0 = 0; j0 < b.nscol; j0 += kSharedBlock) {
     const int j1 = std::min(j0 + kSharedBlock, b.nscol);
-    if (t == 0)
-      for (int j = j0; j < j1; ++j) {
-        const Real* col = trapezoid_column(b.L, b.nsrow, j);
-        const Real xj = (u[j] /= col[j]);
-        for (int i = j + 1; i < j1; ++i) u[i] -= col[i] * xj;
-      }
+    if (t == 0) solve_triangle(b.L, b.scale, b.nsrow, j0, j1, u, x);
     barrier();
     const auto [lo, hi] = share(j1, b.nsrow, t, nt);
-    subtract_columns(b.L, b.nsrow, j0, j1, u, lo, u + lo, hi - lo);
+    subtract_columns(b.L, b.nsrow, j0, j1, x, lo, u + lo, hi - lo);
     barrier();
   }
   const auto [lo, hi] = share(0, b.nsrow, t, nt);
@@ -284,11 +304,11 @@ void ParallelSubstitution::forward_shared(const Real* values, Workspace<Real>& w
 
 // Blocks from the last: the dots of a block's columns with the rows below it, split between
 // the threads by columns, then the block's triangle on thread 0.
-template <class Real>
-void ParallelSubstitution::backward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt) {
-  const Block<Real> b = block(values, s);
-  Real* y = ws.y.data();
-  Real* u = ws.work[0].data();
+template <class Stored>
+void ParallelSubstitution::backward_shared(const Stored* values, int s, int t, int nt) {
+  const Block<Stored> b = block(values, s);
+  double* y = y_.data();
+  double* u = work_[0].data();
   {
     const auto [lo, hi] = share(0, b.nsrow, t, nt);
     for (int i = lo; i < hi; ++i) u[i] = i < b.nscol ? y[b.k1 + i] : y[b.rows[i - b.nscol]];
@@ -297,12 +317,14 @@ void ParallelSubstitution::backward_shared(const Real* values, Workspace<Real>& 
   for (int j1 = b.nscol; j1 > 0;) {
     const int j0 = std::max(0, j1 - kSharedBlock);
     const auto [lo, hi] = share(j0, j1, t, nt);
-    for (int j = lo; j < hi; ++j) u[j] -= dot(trapezoid_column(b.L, b.nsrow, j) + j1, u + j1, b.nsrow - j1);
+    for (int j = lo; j < hi; ++j)
+      u[j] -= dot(trapezoid_column(b.L, b.nsrow, j) + j1, u + j1, b.nsrow - j1) * column_scale<Stored>(b.scale, j);
     barrier();
     if (t == 0)
       for (int j = j1 - 1; j >= j0; --j) {
-        const Real* col = trapezoid_column(b.L, b.nsrow, j);
-        u[j] = (u[j] - dot(col + j + 1, u + j + 1, j1 - j - 1)) / col[j];
+        const Stored* col = trapezoid_column(b.L, b.nsrow, j);
+        const double sj = column_scale<Stored>(b.scale, j);
+        u[j] = (u[j] - dot(col + j + 1, u + j + 1, j1 - j - 1) * sj) / (value(col[j]) * sj);
       }
     barrier();
     j1 = j0;
@@ -313,55 +335,54 @@ void ParallelSubstitution::backward_shared(const Real* values, Workspace<Real>& 
 }
 
 void ParallelSubstitution::solve(const double* b, double* x, bool parallel) {
-  if (L_.values32)
-    solve_with(L_.values32, ws32_, b, x, parallel);
+  if (L_.scaled)
+    solve_with(L_.scaled, b, x, parallel);
   else
-    solve_with(L_.values, ws64_, b, x, parallel);
+    solve_with(L_.values, b, x, parallel);
 }
 
-template <class Real>
-void ParallelSubstitution::solve_with(const Real* values, Workspace<Real>& ws, const double* b, double* x,
-                                      bool parallel) {
+template <class Stored>
+void ParallelSubstitution::solve_with(const Stored* values, const double* b, double* x, bool parallel) {
   const int n = L_.n;
-  for (int k = 0; k < n; ++k) ws.y[k] = static_cast<Real>(b[L_.perm[k]]);
+  for (int k = 0; k < n; ++k) y_[k] = b[L_.perm[k]];
   const int groups = static_cast<int>(groups_.size());
   parallel = parallel && groups > 1;
-  const auto forward_group = [&](int t) {
-    for (const auto& [a, z] : groups_[t])
-      for (int s = a; s <= z; ++s) forward(values, ws, s, ws.acc[t].data(), ws.work[t].data());
+  const auto forward_group = [&](int g) {
+    for (const auto& [a, z] : groups_[g])
+      for (int s = a; s <= z; ++s) forward(values, s, g, false);
   };
-  const auto backward_group = [&](int t) {
-    for (auto g = groups_[t].rbegin(); g != groups_[t].rend(); ++g)
-      for (int s = g->second; s >= g->first; --s) backward(values, ws, s, ws.work[t].data());
+  const auto backward_group = [&](int g) {
+    for (auto r = groups_[g].rbegin(); r != groups_[g].rend(); ++r)
+      for (int s = r->second; s >= r->first; --s) backward(values, s, g);
   };
   // A team smaller than asked for (a thread limit, a nested region) still covers every group.
   if (parallel) {
 #pragma omp parallel num_threads(groups)
     for (int g = thread_index(); g < groups; g += omp_team_size()) forward_group(g);
   } else {
-    for (int t = 0; t < groups; ++t) forward_group(t);
+    for (int g = 0; g < groups; ++g) forward_group(g);
   }
   for (int k : top_rows_)
-    for (int t = 0; t < groups; ++t) {
-      ws.y[k] -= ws.acc[t][k];
-      ws.acc[t][k] = 0;
+    for (int g = 0; g < groups; ++g) {
+      y_[k] -= acc_[g][k];
+      acc_[g][k] = 0;
     }
   // The top, on one thread except for the shared supernodes, whose pieces need all threads.
   const auto top = [&](int t, int nt) {
     const int nt_top = static_cast<int>(top_.size());
     for (int k = 0; k < nt_top; ++k) {
       if (shared_[k]) {
-        forward_shared(values, ws, top_[k], t, nt);
+        forward_shared(values, top_[k], t, nt);
       } else {
-        if (t == 0) forward(values, ws, top_[k], static_cast<Real*>(nullptr), ws.work[0].data());
+        if (t == 0) forward(values, top_[k], 0, true);
         barrier();
       }
     }
     for (int k = nt_top - 1; k >= 0; --k) {
       if (shared_[k]) {
-        backward_shared(values, ws, top_[k], t, nt);
+        backward_shared(values, top_[k], t, nt);
       } else {
-        if (t == 0) backward(values, ws, top_[k], ws.work[0].data());
+        if (t == 0) backward(values, top_[k], 0);
         barrier();
       }
     }
@@ -376,9 +397,9 @@ void ParallelSubstitution::solve_with(const Real* values, Workspace<Real>& ws, c
 #pragma omp parallel num_threads(groups)
     for (int g = thread_index(); g < groups; g += omp_team_size()) backward_group(g);
   } else {
-    for (int t = 0; t < groups; ++t) backward_group(t);
+    for (int g = 0; g < groups; ++g) backward_group(g);
   }
-  for (int k = 0; k < n; ++k) x[L_.perm[k]] = ws.y[k];
+  for (int k = 0; k < n; ++k) x[L_.perm[k]] = y_[k];
 }
 
 }  // namespace pfv

@@ -5,9 +5,10 @@
 // thread, balanced by the number of factor entries, and a top solved on one thread: forwards
 // the groups run in parallel (updates to top rows go to per-thread buffers, summed after),
 // then the top; backwards the top first, then the groups in parallel. The solve is bound by
-// reading the factor, so a second core adds memory bandwidth, and a float factor halves it.
+// reading the factor, so a second core adds memory bandwidth, and a 32-bit factor halves it.
 #pragma once
 #include <algorithm>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -16,9 +17,10 @@ namespace pfv {
 // A read-only view of a supernodal LL' factor with CHOLMOD's pattern (cholmod_factor: super,
 // pi, s, Perm) and compacted values: supernode s (columns super[s]..super[s+1]-1, rows
 // rows[pi[s]..pi[s+1]-1], nsrow of them) starts at values[start[s]], column by column, column j
-// holding only its rows j..nsrow-1 (the lower trapezoid). The values are doubles or floats
-// (exactly one is set): the substitution reads every entry once per pass, so floats halve its
-// memory traffic.
+// holding only its rows j..nsrow-1 (the lower trapezoid). The values are doubles, or 32-bit
+// integers q with L(i, j) ~ q(i, j) * scale[j] for the column's scale (exactly one of values and
+// scaled is set): the substitution reads every entry once per pass, so 32-bit entries halve
+// its memory traffic. The arithmetic is double either way.
 struct SupernodalFactor {
   int n = 0, nsuper = 0;
   const int* super = nullptr;
@@ -27,7 +29,8 @@ struct SupernodalFactor {
   const int* rows = nullptr;
   const int* perm = nullptr;
   const double* values = nullptr;
-  const float* values32 = nullptr;
+  const std::int32_t* scaled = nullptr;
+  const double* scale = nullptr;  // per column, in elimination order; with 'scaled'
 };
 
 class ParallelSubstitution {
@@ -47,39 +50,34 @@ class ParallelSubstitution {
   void solve(const double* b, double* x, bool parallel = true);
 
  private:
-  // Per-thread update buffers and the permuted right-hand side, in the factor's precision:
-  // with a float factor the whole substitution runs in float (refinement recovers double
-  // accuracy, and float arithmetic moves twice as many entries per vector instruction).
-  template <class Real>
-  struct Workspace {
-    std::vector<std::vector<Real>> acc, work;
-    std::vector<Real> y;
-  };
   // Supernode s: its first column k1, its nscol columns and nsrow rows, the rows below its
-  // diagonal block, and its values.
-  template <class Real>
+  // diagonal block, its values and (32-bit entries) its columns' scales.
+  template <class Stored>
   struct Block {
     int k1, nscol, nsrow;
     const int* rows;
-    const Real* L;
+    const Stored* L;
+    const double* scale;
   };
-  template <class Real>
-  Block<Real> block(const Real* values, int s) const {
+  template <class Stored>
+  Block<Stored> block(const Stored* values, int s) const {
     const int k1 = L_.super[s];
-    return {k1, L_.super[s + 1] - k1, L_.pi[s + 1] - L_.pi[s], L_.rows + L_.pi[s] + (L_.super[s + 1] - k1),
-            values + L_.start[s]};
+    return {k1,     L_.super[s + 1] - k1, L_.pi[s + 1] - L_.pi[s], L_.rows + L_.pi[s] + (L_.super[s + 1] - k1),
+            values + L_.start[s], L_.scale ? L_.scale + k1 : nullptr};
   }
-  template <class Real>
-  void forward(const Real* values, Workspace<Real>& ws, int s, Real* acc, Real* w);
-  template <class Real>
-  void backward(const Real* values, Workspace<Real>& ws, int s, Real* w);
+  // 'thread' is the group (forward, backward) or the thread of the team (shared supernodes);
+  // its buffers are acc_[thread], work_[thread] and scaled_[thread].
+  template <class Stored>
+  void forward(const Stored* values, int s, int thread, bool top);
+  template <class Stored>
+  void backward(const Stored* values, int s, int thread);
   // Thread t of nt's part of supernode s (a top one, after all of its descendants).
-  template <class Real>
-  void forward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt);
-  template <class Real>
-  void backward_shared(const Real* values, Workspace<Real>& ws, int s, int t, int nt);
-  template <class Real>
-  void solve_with(const Real* values, Workspace<Real>& ws, const double* b, double* x, bool parallel);
+  template <class Stored>
+  void forward_shared(const Stored* values, int s, int t, int nt);
+  template <class Stored>
+  void backward_shared(const Stored* values, int s, int t, int nt);
+  template <class Stored>
+  void solve_with(const Stored* values, const double* b, double* x, bool parallel);
 
   SupernodalFactor L_;
   std::vector<std::vector<std::pair<int, int>>> groups_;  // per thread: supernode ranges
@@ -87,8 +85,10 @@ class ParallelSubstitution {
   std::vector<char> shared_;                              // per top_ entry
   std::vector<char> top_row_;                             // per row: owned by a top supernode
   std::vector<int> top_rows_;
-  Workspace<double> ws64_;
-  Workspace<float> ws32_;
+  // Per group: updates of top rows, the rows below a supernode, and x(j) * scale(j) of its
+  // columns (32-bit entries); the permuted right-hand side and solution.
+  std::vector<std::vector<double>> acc_, work_, scaled_;
+  std::vector<double> y_;
   double top_fraction_ = 1;
 };
 

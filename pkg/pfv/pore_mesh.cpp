@@ -89,7 +89,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
     CholmodSolver& f = *l.cholmod;
     f.set_openmp_teams(settings.cholmod_openmp_teams);
     f.factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering,
-                settings.mixed_precision ? FactorPrecision::kSingle : FactorPrecision::kDouble, given);
+                settings.mixed_precision ? FactorPrecision::kScaled32 : FactorPrecision::kDouble, given);
     if (f.ready() && f.permutation())
       l.ordering = std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
                                                         f.ordering_given() ? previous->fresh_fill() : f.fill(),

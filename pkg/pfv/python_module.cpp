@@ -197,7 +197,7 @@ PYBIND11_MODULE(_core, m) {
                     [](FlowEngine& e, bool v) { e.settings.reuse_ordering = v; })
       .def("ordering_reused", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().ordering_given(); })
       .def("factor_fill", [](const FlowEngine& e) { return e.has_mesh() ? e.cholmod().fill() : 0.0; })
-      .def("single_precision_factor", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().single_precision(); })
+      .def("single_precision_factor", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().reduced_precision(); })
       .def("refinement_contraction", &FlowEngine::refinement_contraction)
       .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholmod().factor_nonzeros(); })
       .def("factor_flops", [](const FlowEngine& e) { return e.cholmod().factor_flops(); })

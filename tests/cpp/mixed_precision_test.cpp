@@ -1,5 +1,6 @@
-// A single-precision factor inside iterative refinement gives the double solve's pressures,
-// and falls back to double when the system is beyond float.
+// A 32-bit factor (integers scaled per column) inside iterative refinement gives the double
+// solve's pressures to the refinement tolerance, and falls back to double when the system is
+// beyond it.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -61,23 +62,31 @@ TEST(MixedPrecision, MatchesTheDoubleSolveOverMovingSteps) {
   const double dt = 1e-3;
   for (int step = 0; step < 6; ++step) {
     for (std::size_t k = 0; k < x.size(); ++k)  // a slow, smooth squeeze along y: dV/dt != 0
-      x[k].y() = 0.5 + (p.centre[k].y() - 0.5) * (1 - 2e-4 * step);
+      x[k].y() = 0.5 + (p.centre[k].y() - 0.5) * (1 - 2e-4 * step * (1 + 0.1 * step));
     exact.step(x, p.radius, p.walls, dt);
     mixed.step(x, p.radius, p.walls, dt);
-    ASSERT_TRUE(mixed.cholmod().single_precision());
-    const double scale = max_abs(exact.pressure());
-    ASSERT_GT(scale, 0);
+    ASSERT_TRUE(mixed.cholmod().reduced_precision());
+    const auto [lo, hi] = std::minmax_element(exact.pressure().begin(), exact.pressure().end());
+    const double spread = *hi - *lo;
+    ASSERT_GT(spread, 0);
+    // The stopping rule's promise: within refinement_tolerance of the spread.
     for (std::size_t c = 0; c < exact.pressure().size(); ++c)
-      ASSERT_NEAR(mixed.pressure()[c], exact.pressure()[c], 1e-9 * scale) << "step " << step << " cell " << c;
-    if (step > 0) {
+      ASSERT_NEAR(mixed.pressure()[c], exact.pressure()[c], mixed.settings.refinement_tolerance * spread)
+          << "step " << step << " cell " << c;
+    // Step 1 is the first with a volume change (a jump of the pressures) and step 2 extrapolates
+    // that jump; from then on the start is extrapolated from a smooth history: one pass.
+    if (step >= 3) {
+      EXPECT_EQ(mixed.gs_iterations(), 1) << "refinement passes at step " << step;
+    } else if (step > 0) {
       EXPECT_LE(mixed.gs_iterations(), 2) << "refinement passes at step " << step;
     }
   }
+  // Far below float's 2.5e-7 on such systems; the estimate includes a safety factor of 4.
   EXPECT_GT(mixed.refinement_contraction(), 0);
-  EXPECT_LT(mixed.refinement_contraction(), 0.01);
-  ASSERT_FALSE(exact.cholmod().single_precision());
+  EXPECT_LT(mixed.refinement_contraction(), 1e-6);
+  ASSERT_FALSE(exact.cholmod().reduced_precision());
   for (std::size_t v = 0; v < exact.forces().size(); ++v)
-    EXPECT_LE((mixed.forces()[v] - exact.forces()[v]).norm(), 1e-8 * (exact.forces()[v].norm() + 1e-12));
+    EXPECT_LE((mixed.forces()[v] - exact.forces()[v]).norm(), 1e-9 * (exact.forces()[v].norm() + 1e-12));
 }
 
 TEST(MixedPrecision, ToleranceFollowsThePressureDifferencesNotTheirOffset) {
@@ -96,7 +105,7 @@ TEST(MixedPrecision, ToleranceFollowsThePressureDifferencesNotTheirOffset) {
     for (std::size_t k = 0; k < x.size(); ++k) x[k].y() = 0.5 + (p.centre[k].y() - 0.5) * (1 - 1e-6 * step);
     exact.step(x, p.radius, p.walls, 1e-3);
     mixed.step(x, p.radius, p.walls, 1e-3);
-    ASSERT_TRUE(mixed.cholmod().single_precision());
+    ASSERT_TRUE(mixed.cholmod().reduced_precision());
     const auto [lo, hi] = std::minmax_element(exact.pressure().begin(), exact.pressure().end());
     const double spread = *hi - *lo;
     ASSERT_GT(spread, 0.5);
@@ -108,16 +117,17 @@ TEST(MixedPrecision, ToleranceFollowsThePressureDifferencesNotTheirOffset) {
 }
 
 TEST(MixedPrecision, LongChainConvergesDespiteItsConditionNumber) {
-  // cond(G) ~ 16 n^2 / pi^2 ~ 6e8, beyond float's 1 / 6e-8 - yet G is a graph Laplacian (an
-  // M-matrix) whose rounded factor stays a componentwise-small perturbation: refinement still
-  // contracts. The conductance matrices of the pore network are all of this kind.
+  // cond(G) ~ 16 n^2 / pi^2 ~ 6e8, close to the 2^31 steps of the 32-bit columns - yet G is a
+  // graph Laplacian (an M-matrix) whose stored factor stays a small perturbation of each
+  // column: refinement still contracts. The conductance matrices of the pore network are all
+  // of this kind.
   const PressureSystem s = graded_chain(20000, 0);
   std::vector<double> b(s.n_unknowns(), 0.0), x;
   b.back() = 1e-10;  // a flux injected at the closed end
   const std::vector<double> x_exact = double_solve(s, b);
   CholmodSolver single;
-  single.factorize(s, Ordering::kAmd, FactorPrecision::kSingle);
-  ASSERT_TRUE(single.single_precision());
+  single.factorize(s, Ordering::kAmd, FactorPrecision::kScaled32);
+  ASSERT_TRUE(single.reduced_precision());
   Refinement r;
   x.assign(b.size(), 0.0);
   ASSERT_TRUE(r.solve(s, single, b, x, 1e-10, 8));
@@ -127,10 +137,10 @@ TEST(MixedPrecision, LongChainConvergesDespiteItsConditionNumber) {
 }
 
 TEST(MixedPrecision, IllConditionedDenseSystemIsDetectedAndSolvedInDouble) {
-  // Eigenvalues 1 ... 1e-15 along random directions. Rounding the factor L to float makes
-  // I - M^-1 G similar to L^-1 dL + (L^-1 dL)', of norm ~ sqrt(cond) * 6e-8: here ~2, so the
-  // passes do not contract and the caller refactorises in double. (At cond 1e10 rho is still
-  // ~1e-3: graph Laplacians never get near this.)
+  // Eigenvalues 1 ... 1e-15 along random directions. Storing the factor L with 2^-31 of each
+  // column's largest entry as its unit makes I - M^-1 G similar to L^-1 dL + (L^-1 dL)', of
+  // norm up to ~ cond * 5e-10 for such a dense L: here the passes do not contract and the
+  // caller refactorises in double. (Graph Laplacians never get near this.)
   const int n = 30;
   std::mt19937 gen(5);
   std::normal_distribution<double> normal;
@@ -155,12 +165,12 @@ TEST(MixedPrecision, IllConditionedDenseSystemIsDetectedAndSolvedInDouble) {
   for (int i = 0; i < n; ++i) b[i] = std::sin(1.0 + i);
   const std::vector<double> x_exact = double_solve(s, b);
   CholmodSolver single;
-  single.factorize(s, Ordering::kAmd, FactorPrecision::kSingle);
-  ASSERT_TRUE(single.single_precision());
+  single.factorize(s, Ordering::kAmd, FactorPrecision::kScaled32);
+  ASSERT_TRUE(single.reduced_precision());
   Refinement r;
   EXPECT_FALSE(r.solve(s, single, b, x, 1e-10, 8));
   single.promote_to_double(s);
-  EXPECT_FALSE(single.single_precision());
+  EXPECT_FALSE(single.reduced_precision());
   single.solve(b, x);
   for (int i = 0; i < n; ++i) EXPECT_EQ(x[i], x_exact[i]);  // the same double factor
 }
@@ -171,23 +181,50 @@ TEST(MixedPrecision, WellConditionedChainConvergesFromAColdStart) {
   for (std::size_t i = 0; i < b.size(); ++i) b[i] = std::cos(0.1 * i);
   const std::vector<double> x_exact = double_solve(s, b);
   CholmodSolver single;
-  single.factorize(s, Ordering::kAmd, FactorPrecision::kSingle);
+  single.factorize(s, Ordering::kAmd, FactorPrecision::kScaled32);
   Refinement refine;
   ASSERT_TRUE(refine.solve(s, single, b, x, 1e-12, 8));
-  EXPECT_GE(refine.passes(), 2);  // a float solve alone is not accurate to 1e-12
+  EXPECT_GE(refine.passes(), 2);  // one 32-bit solve alone is not accurate to 1e-12
   const double scale = max_abs(x_exact);
   for (std::size_t i = 0; i < x.size(); ++i) ASSERT_NEAR(x[i], x_exact[i], 1e-11 * scale);
   residual(s, b, x, r);
   EXPECT_LE(max_abs(r), 1e-13 * max_abs(x) * 2);  // round-off level: |G| <= 2 max k = 2
 }
 
-TEST(MixedPrecision, FactorOutsideFloatRangeStaysDouble) {
-  const PressureSystem s = graded_chain(100, 1, 1e80);  // factor entries ~1e40 > FLT_MAX
-  CholmodSolver solver;
-  solver.factorize(s, Ordering::kAmd, FactorPrecision::kSingle);
-  EXPECT_FALSE(solver.single_precision());
-  std::vector<double> b(s.n_unknowns(), 1e80), x, r;
-  solver.solve(b, x);
-  residual(s, b, x, r);
-  EXPECT_LE(max_abs(r), 1e-10 * max_abs(b));
+TEST(MixedPrecision, FactorOfAnyMagnitudeKeepsItsPrecision) {
+  // Each column carries its own double scale: conductances of 1e80 or 1e-80 (factor entries
+  // 1e40, 1e-40, outside float's range) lose nothing to the 32-bit format.
+  for (double scale : {1e80, 1e-80}) {
+    const PressureSystem s = graded_chain(100, 1, scale);
+    CholmodSolver solver;
+    solver.factorize(s, Ordering::kAmd, FactorPrecision::kScaled32);
+    EXPECT_TRUE(solver.reduced_precision()) << scale;
+    std::vector<double> b(s.n_unknowns(), scale), x(s.n_unknowns(), 0.0);
+    const std::vector<double> x_exact = double_solve(s, b);
+    Refinement refine;
+    ASSERT_TRUE(refine.solve(s, solver, b, x, 1e-12, 8)) << scale;
+    EXPECT_LT(refine.contraction(), 1e-6) << scale;
+    const double size = max_abs(x_exact);
+    for (std::size_t i = 0; i < x.size(); ++i) ASSERT_NEAR(x[i], x_exact[i], 1e-11 * size) << scale;
+  }
+}
+
+TEST(MixedPrecision, OneSubstitutionIsAccurateToTheFormat) {
+  // Without refinement: the 32-bit factor's solve, against the double one on the same system.
+  // Its error is the contraction times the solution, about 1e-8 here (float entries: 3e-7).
+  const auto p = test::random_packing(3000, 12, 0.02, 0.03);
+  FlowEngine exact = test::permeameter(1), mixed = test::permeameter(1);
+  mixed.settings.mixed_precision = true;
+  exact.step(p.centre, p.radius, p.walls, 1.0);
+  mixed.step(p.centre, p.radius, p.walls, 1.0);
+  ASSERT_TRUE(mixed.cholmod().reduced_precision());
+  const int nu = exact.system().n_unknowns();
+  std::vector<double> b(nu), x64, x32;
+  for (int i = 0; i < nu; ++i) b[i] = std::sin(0.37 * i) + 0.1 * (i % 7);
+  const_cast<CholmodSolver&>(exact.cholmod()).solve(b, x64);
+  const_cast<CholmodSolver&>(mixed.cholmod()).solve(b, x32);
+  double error = 0;
+  for (int i = 0; i < nu; ++i) error = std::max(error, std::abs(x32[i] - x64[i]));
+  EXPECT_LT(error, 1e-7 * max_abs(x64));
+  EXPECT_GT(error, 0);  // it is a different factor
 }

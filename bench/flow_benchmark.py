@@ -4,7 +4,7 @@ Run with YADE (the driver re-invokes yade-double on this file for every measurem
 
     yade-double -n -x bench/flow_benchmark.py [--quick] [--sizes=1000,10000,50000] [--rounds=3]
                 [--threads=1,2] [--out=doc/benchmarks.md] [--json=FILE] [--no-memory] [--no-oedometer]
-                [--no-multithread] [--oedo-sizes=1000,10000] [--oedo-steps=600] [--oedo-interval=200] [--steady=20]
+                [--no-multithread] [--no-double] [--oedo-sizes=1000,10000] [--oedo-steps=600] [--oedo-interval=200] [--steady=20]
                 [--gen-threads=T]    (threads of the child that generates a missing packing; default max of --threads)
 
 --quick: 300 spheres, 1 round, -j1, 10 steady steps, oedometer 60 steps with a remesh every 20, report written to
@@ -19,7 +19,9 @@ What it does
      six fixed walls, spheres *dynamic* (no blocked DOFs), friction 30 deg, no gravity, pressure drop 100 Pa along y =
      1 % of the confining stress, viscosity 1e-3, O.dt = 0.5 P-wave step, slipBoundary=False in both engines) is
      settled (damping 0.5 until the unbalanced force is < 0.01: the file has no contact history), saved once with
-     O.saveTmp, and every trial starts from it.  Trials are interleaved YADE / PFV / dry, rotating the order every round.  A trial runs
+     O.saveTmp, and every trial starts from it.  Trials are interleaved YADE / PFV / dry / PFV-double (PFV with
+     mixed_precision=False, the direct double solve the default is refined towards; not with --no-double), rotating
+     the order every round.  A trial runs
      W=3 first steps, S steady steps, a forced remesh (updateTriangulation=True) followed by W steps, and 3 more steps,
      timing every O.step() (wall clock) and the engine's execTime (O.timingEnabled).  Both engines use CHOLMOD
      (useSolver=3), meshUpdateInterval=1e9, defTolerance=0, everything else at its default.
@@ -103,6 +105,7 @@ def parse_args(argv):
         memory=True,
         oedometer=True,
         multithread=True,
+        double=True,
         oedo_sizes=None,
         oedo_steps=60 if quick else 600,
         oedo_interval=20 if quick else 200,
@@ -124,6 +127,9 @@ def parse_args(argv):
             continue
         if a == '--no-multithread':
             opts['multithread'] = False
+            continue
+        if a == '--no-double':
+            opts['double'] = False
             continue
         if not a.startswith('--') or '=' not in a:
             raise SystemExit('flow_benchmark: unknown argument %r (see the docstring)' % a)
@@ -305,6 +311,7 @@ def build_scene(n, oedometer=False, settle=True):
 
 
 def make_engine(kind, oedometer=False, oedo_interval=200):
+    """kind: 'yade', 'pfv' (defaults) or 'pfv-double' (pfv with mixed_precision=False)."""
     if kind == 'yade':
         from yade.wrapper import FlowEngine as Flow
     else:
@@ -330,11 +337,13 @@ def make_engine(kind, oedometer=False, oedo_interval=200):
     flow.permeabilityFactor = 1.0
     flow.useSolver = 3
     flow.slipBoundary = False  # YADE's slip factor on wall throats is a known model difference (-15 % flux)
-    if kind == 'pfv':
-        # PFV options under test, e.g. PFV_BENCH_SET="mixed_precision=True" (inherited by the children).
+    if kind.startswith('pfv'):
+        # PFV options under test, e.g. PFV_BENCH_SET="mixed_precision=False" (inherited by the children).
         for item in filter(None, os.environ.get('PFV_BENCH_SET', '').split(',')):
             name, value = item.split('=', 1)
             setattr(flow, name.strip(), ast.literal_eval(value.strip()))
+    if kind == 'pfv-double':
+        flow.mixed_precision = False  # the double factor, every solve direct: the reference of the default
     return flow
 
 
@@ -440,7 +449,7 @@ def run_trial(kind, info, steady, warnings_seen):
         return res
 
     flow = make_engine(kind)
-    proxy = install_core_timer(flow) if kind == 'pfv' else None
+    proxy = install_core_timer(flow) if kind.startswith('pfv') else None
     insert_engine(flow)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter('always')
@@ -453,7 +462,7 @@ def run_trial(kind, info, steady, warnings_seen):
             ex = (flow.execTime - e0) * 1e-9
             record['wall'].append(wall)
             record['exec'].append(ex)
-            if kind == 'pfv':
+            if kind.startswith('pfv'):
                 core = flow.core
                 record.setdefault('step_times', []).append(dict(core.step_times()))
                 record.setdefault('remesh_count', []).append(core.remesh_count)
@@ -464,7 +473,7 @@ def run_trial(kind, info, steady, warnings_seen):
         td0 = _yade_td(flow)
         for _ in range(WINDOW):
             step(first)
-        if kind == 'pfv':
+        if kind.startswith('pfv'):
             first['remesh_times'] = dict(flow.core.remesh_times())
         st = dict(wall=[], exec=[])
         td1 = _yade_td(flow)
@@ -478,7 +487,7 @@ def run_trial(kind, info, steady, warnings_seen):
         for _ in range(WINDOW):
             step(rem)
         td3 = _yade_td(flow)
-        if kind == 'pfv':
+        if kind.startswith('pfv'):
             rem['remesh_times'] = dict(flow.core.remesh_times())
         tail = dict(wall=[], exec=[])
         for _ in range(3):
@@ -574,8 +583,8 @@ def timing_child(opts):
         log('timing n=%d (%d bodies, dt %.3g, settled in %d steps to unbalanced force %.3g) threads=%d, %d rounds, '
             '%d steady steps' % (n, info['bodies'], info['dt'], info['settle_steps'], info['unbalanced'], O.numThreads,
                                  rounds, steady))
-        trials = dict(yade=[], pfv=[], dry=[])
-        order = ['yade', 'pfv', 'dry']
+        order = ['yade', 'pfv', 'dry'] + (['pfv-double'] if opts['double'] else [])
+        trials = {kind: [] for kind in order}
         for r in range(rounds):
             k = r % 3
             for kind in order[k:] + order[:k]:
@@ -736,7 +745,7 @@ def summarise(timing, memory):
             row['dry'] = median(dry)
             row['dry_range'] = (min(dry), max(dry)) if dry else None
             row['vmax'] = {k: max([x.get('vmax', float('nan')) for x in tr[k]] or [float('nan')]) for k in tr}
-            for kind in ('yade', 'pfv'):
+            for kind in [k for k in ('yade', 'pfv', 'pfv-double') if tr.get(k)]:
                 flow_step, remesh, first, coupled = [], [], [], []
                 for x in tr[kind]:
                     fs = median(x['steady']['exec'])
@@ -760,6 +769,10 @@ def summarise(timing, memory):
                                         flux_out_rel=abs(fp[1] - fy[1]) / abs(fy[1]) if fy[1] else float('nan'),
                                         flux_yade=fy, flux_pfv=fp,
                                         probe_yade=py[13], probe_pfv=pp[13])
+            if tr['pfv'] and tr.get('pfv-double'):
+                # the default (32-bit factor, refined) against the direct double solve, same steps from the same state
+                pp, pd = tr['pfv'][0]['probes'], tr['pfv-double'][0]['probes']
+                row['double_agreement'] = dict(max_dp=max(abs(a - b) / DP for a, b in zip(pp, pd)))
             # PFV breakdown
             step_stages = ('volumes', 'solve', 'forces')
             br = {'remesh': {}, 'steady': {}}
@@ -912,6 +925,24 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
                  fmt_t(p['coupled']), fmt_t(r['dry']), fmt_r(p['coupled_minus_dry'], y['coupled_minus_dry']),
                  fmt_t(y['first']), fmt_t(p['first'])))
         w('')
+        dbl = [ns for ns in sorted(sizes, key=int) if 'pfv-double' in sizes[ns]]
+        if dbl:
+            w('PFV with the double factor (`mixed_precision=False`: every solve a direct double substitution; the '
+              'default keeps the factor in 32 bits and refines each solve to `refinement_tolerance` = 1e-10 of the '
+              'pressure spread), same trials:')
+            w('')
+            w('| N | remesh PFV double | P/Y | flow step PFV double | P/Y | coupled PFV double | (coupled-dry) P/Y '
+              '| default / double flow step | max abs(p default - p double) / dp over 27 probes |')
+            w('|---|---|---|---|---|---|---|---|---|')
+            for ns in dbl:
+                r = sizes[ns]
+                y, p, d = r['yade'], r['pfv'], r['pfv-double']
+                w('| %s | %s | %s | %s | %s | %s | %s | %.2f | %.1e |'
+                  % (ns, fmt_t(d['remesh']), fmt_r(d['remesh'], y['remesh']), fmt_t(d['flow']),
+                     fmt_r(d['flow'], y['flow']), fmt_t(d['coupled']),
+                     fmt_r(d['coupled_minus_dry'], y['coupled_minus_dry']), p['flow'] / d['flow'],
+                     r.get('double_agreement', {}).get('max_dp', float('nan'))))
+            w('')
         w('Spread over rounds (min-max): ' + '; '.join(
             'N=%s remesh Y %s-%s P %s-%s, flow Y %s-%s P %s-%s' % (
                 ns, fmt_t(sizes[ns]['yade']['remesh_range'][0]), fmt_t(sizes[ns]['yade']['remesh_range'][1]),

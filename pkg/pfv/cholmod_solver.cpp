@@ -101,7 +101,7 @@ cholmod_sparse view_of(const PressureSystem& s) {
 }  // namespace
 
 void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, FactorPrecision precision,
-                             const GivenOrdering& given) {
+                             const GivenOrdering& given, double min_scaled_entries) {
   release();
   cholmod_common* c = &common_->c;
   const int n = s.n_unknowns();
@@ -137,6 +137,7 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
   numeric_factorization(s);
   reduced_ = precision == FactorPrecision::kScaled32;
+  min_scaled_entries_ = min_scaled_entries;
   plan_substitution(s);
 }
 
@@ -252,6 +253,7 @@ void CholmodSolver::plan_substitution(const PressureSystem& system) {
   // From here on CHOLMOD's routines must not read the values (solve_serial never calls them).
   auto* v = static_cast<double*>(f->x);
   trapezoid_start_ = compact_to_trapezoids(v, *f);
+  if (reduced_ && trapezoid_start_.back() < min_scaled_entries_) reduced_ = false;  // small: double pays
   if (reduced_ && !scale_to_int32(v, *f, trapezoid_start_, scale_)) {
     std::vector<double>().swap(scale_);  // stay double: factorise again, the values were overwritten
     reduced_ = false;

@@ -54,8 +54,10 @@ class CholmodSolver {
   // double when a column's scale is not a normal double (never for the pore networks; kept
   // because the format's error bound assumes it).
   // 'ordering' is computed unless 'given' is accepted.
+  // kScaled32 applies to factors of at least min_scaled_entries stored entries (after compaction).
   void factorize(const PressureSystem& system, Ordering ordering,
-                 FactorPrecision precision = FactorPrecision::kDouble, const GivenOrdering& given = {});
+                 FactorPrecision precision = FactorPrecision::kDouble, const GivenOrdering& given = {},
+                 double min_scaled_entries = 0);
   // Refactorises in double on the same ordering (no new analysis): for when refinement with
   // the 32-bit factor does not converge (G too ill-conditioned for it).
   void promote_to_double(const PressureSystem& system);
@@ -91,6 +93,7 @@ class CholmodSolver {
   void* factor_ = nullptr;  // cholmod_factor*
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
   bool reduced_ = false;       // kScaled32 asked for (until a fallback to double)
+  double min_scaled_entries_ = 0;
   std::vector<double> scale_;  // per column (elimination order) with kScaled32; empty in double
   ParallelSubstitution parallel_;
   bool metis_used_ = false;

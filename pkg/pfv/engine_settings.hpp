@@ -19,10 +19,15 @@ struct EngineSettings {
   bool reuse_ordering = true;
   double max_fill_growth = 1.1;
   // useSolver 3 only: keep the Cholesky factor as 32-bit integers scaled per column
-  // (FactorPrecision::kScaled32) and refine each solve in double from the previous pressures
-  // (refinement.hpp) until the estimated error is below refinement_tolerance * (max p - min p)
-  // over the unknowns. Falls back to the double factor if G is too ill-conditioned for it.
-  bool mixed_precision = false;
+  // (FactorPrecision::kScaled32) and refine each solve in double from the previous (extrapolated)
+  // pressures (refinement.hpp) until the estimated error is below refinement_tolerance *
+  // (max p - min p) over the unknowns. Falls back to the double factor if G is too
+  // ill-conditioned for it. Only for factors of at least mixed_precision_min_entries stored
+  // entries: a smaller double factor is served from the caches, and the residual of each pass
+  // costs what the 32-bit factor saves (parity at 3 000 spheres, 1.7e6 entries; 20 % faster at
+  // 50 000, doc/benchmarks.md).
+  bool mixed_precision = true;
+  double mixed_precision_min_entries = 2e6;
   double refinement_tolerance = 1e-10;
   int max_refinement_passes = 8;
   // Let CHOLMOD fork the OpenMP teams of its numeric factorisation (4 threads, compiled in)

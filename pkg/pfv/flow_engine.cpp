@@ -121,7 +121,9 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   }
   const bool solver_missing = linear_.system.n_unknowns() > 0 &&
                               ((settings.use_solver == 3 && (!linear_.cholmod->ready() ||
-                                                             linear_.mixed_precision != settings.mixed_precision)) ||
+                                                             linear_.mixed_precision != settings.mixed_precision ||
+                                                             linear_.mixed_precision_min_entries !=
+                                                                 settings.mixed_precision_min_entries)) ||
                                (settings.use_solver == 1 && !linear_.pcg.ready()));
   const bool storage_stale = (settings.fluid_bulk_modulus > 0) != !linear_.storage.empty() ||
                              (!linear_.storage.empty() && dt != linear_.dt);

@@ -91,7 +91,7 @@ class FlowEngine {
   const CholmodSolver& cholmod() const { return *linear_.cholmod; }
   int remesh_count() const { return remesh_count_; }
   double accumulated_strain() const { return strain_; }
-  // Iterations of the last iterative solve, or refinement passes with a single-precision factor.
+  // Iterations of the last iterative solve, or refinement passes with a 32-bit factor.
   int gs_iterations() const { return gs_iterations_; }
   double refinement_contraction() const { return linear_.refinement.contraction(); }
   const StageTimes& remesh_times() const { return remesh_times_; }

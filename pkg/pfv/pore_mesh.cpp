@@ -56,6 +56,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   LinearSystem l;
   l.dt = dt;
   l.mixed_precision = settings.mixed_precision;
+  l.mixed_precision_min_entries = settings.mixed_precision_min_entries;
   if (settings.fluid_bulk_modulus > 0) {
     l.storage.resize(m.mesh().n_cells());
     for (int c = 0; c < m.mesh().n_cells(); ++c)
@@ -89,7 +90,8 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
     CholmodSolver& f = *l.cholmod;
     f.set_openmp_teams(settings.cholmod_openmp_teams);
     f.factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering,
-                settings.mixed_precision ? FactorPrecision::kScaled32 : FactorPrecision::kDouble, given);
+                settings.mixed_precision ? FactorPrecision::kScaled32 : FactorPrecision::kDouble, given,
+                settings.mixed_precision_min_entries);
     if (f.ready() && f.permutation())
       l.ordering = std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
                                                         f.ordering_given() ? previous->fresh_fill() : f.fill(),

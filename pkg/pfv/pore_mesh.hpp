@@ -38,8 +38,9 @@ struct LinearSystem {
   std::vector<int> coupling_unknown, coupling_cell;  // Dirichlet neighbours of unknowns
   std::vector<double> coupling_k;
   std::unique_ptr<CholmodSolver> cholmod = std::make_unique<CholmodSolver>();  // useSolver 3
-  Refinement refinement;         // with a single-precision factor
-  bool mixed_precision = false;  // the setting the factor was built for
+  Refinement refinement;         // with a 32-bit factor
+  bool mixed_precision = false;  // the settings the factor was built for
+  double mixed_precision_min_entries = 0;
   std::shared_ptr<const CellOrdering> ordering;  // of the factor, for the next remesh
   PcgSolver pcg;                                                               // useSolver 1
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;

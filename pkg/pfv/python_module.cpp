@@ -186,6 +186,13 @@ PYBIND11_MODULE(_core, m) {
                     })
       .def_property("mixed_precision", [](const FlowEngine& e) { return e.settings.mixed_precision; },
                     [](FlowEngine& e, bool v) { e.settings.mixed_precision = v; })
+      .def_property("mixed_precision_min_entries",
+                    [](const FlowEngine& e) { return e.settings.mixed_precision_min_entries; },
+                    [](FlowEngine& e, double v) {
+                      if (!(v >= 0 && std::isfinite(v)))
+                        throw py::value_error("mixed_precision_min_entries must be finite and >= 0");
+                      e.settings.mixed_precision_min_entries = v;
+                    })
       .def_property("refinement_tolerance", [](const FlowEngine& e) { return e.settings.refinement_tolerance; },
                     [](FlowEngine& e, double v) {
                       if (!(v > 0 && v < 1)) throw py::value_error("refinement_tolerance must be in (0, 1)");
@@ -197,7 +204,7 @@ PYBIND11_MODULE(_core, m) {
                     [](FlowEngine& e, bool v) { e.settings.reuse_ordering = v; })
       .def("ordering_reused", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().ordering_given(); })
       .def("factor_fill", [](const FlowEngine& e) { return e.has_mesh() ? e.cholmod().fill() : 0.0; })
-      .def("single_precision_factor", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().reduced_precision(); })
+      .def("reduced_precision_factor", [](const FlowEngine& e) { return e.has_mesh() && e.cholmod().reduced_precision(); })
       .def("refinement_contraction", &FlowEngine::refinement_contraction)
       .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholmod().factor_nonzeros(); })
       .def("factor_flops", [](const FlowEngine& e) { return e.cholmod().factor_flops(); })

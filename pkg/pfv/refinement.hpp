@@ -1,11 +1,12 @@
 // Iterative refinement of G x = b with an approximate factor M ~ G (the factor rounded to
-// single precision, cholmod_solver.hpp):  x <- x + M^-1 (b - G x), the residual in double.
+// 32-bit integers scaled per column, cholmod_solver.hpp): x <- x + M^-1 (b - G x), the residual
+// in double.
 //
-// The iteration contracts the error by rho = ||I - M^-1 G|| per pass: about sqrt(cond(G)) *
-// 6e-8 for a factor computed in double and rounded (1e-7 on the pore networks measured), and
-// it starts from the previous step's pressures, which differ from the new ones by the
-// (usually small) change of one DEM step: one or two passes reach double-precision accuracy
-// while each pass reads half the bytes of a double substitution. rho is estimated once per
+// The iteration contracts the error by rho = ||I - M^-1 G|| per pass: 1e-8 to 2e-8 on the pore
+// networks measured (10 000 to 50 000 spheres), and it starts from pressures that differ from
+// the new ones by about the change of one DEM step (1e-4 to 4e-4 of their spread): one pass
+// meets a tolerance of 1e-10 while it reads half the bytes of a double substitution (plus G
+// once, for the residual). rho is estimated once per
 // factor, before its first solve, by a few power iterations on I - M^-1 G (times a safety
 // factor: the power iteration approaches rho from below); a solve stops as soon as the
 // estimated error rho / (1 - rho) * |correction| is below the tolerance, relative to the spread

@@ -58,6 +58,7 @@ TEST(MixedPrecision, MatchesTheDoubleSolveOverMovingSteps) {
   FlowEngine exact = test::permeameter(1), mixed = test::permeameter(1);
   exact.settings.mixed_precision = false;
   mixed.settings.mixed_precision = true;
+  mixed.settings.mixed_precision_min_entries = 0;  // small systems: 32 bits all the same
   std::vector<Vec3> x = p.centre;
   const double dt = 1e-3;
   for (int step = 0; step < 6; ++step) {
@@ -100,6 +101,7 @@ TEST(MixedPrecision, ToleranceFollowsThePressureDifferencesNotTheirOffset) {
   }
   exact.settings.mixed_precision = false;
   mixed.settings.mixed_precision = true;
+  mixed.settings.mixed_precision_min_entries = 0;  // small systems: 32 bits all the same
   std::vector<Vec3> x = p.centre;
   for (int step = 0; step < 3; ++step) {
     for (std::size_t k = 0; k < x.size(); ++k) x[k].y() = 0.5 + (p.centre[k].y() - 0.5) * (1 - 1e-6 * step);
@@ -214,7 +216,9 @@ TEST(MixedPrecision, OneSubstitutionIsAccurateToTheFormat) {
   // Its error is the contraction times the solution, about 1e-8 here (float entries: 3e-7).
   const auto p = test::random_packing(3000, 12, 0.02, 0.03);
   FlowEngine exact = test::permeameter(1), mixed = test::permeameter(1);
+  exact.settings.mixed_precision = false;
   mixed.settings.mixed_precision = true;
+  mixed.settings.mixed_precision_min_entries = 0;  // whatever the size
   exact.step(p.centre, p.radius, p.walls, 1.0);
   mixed.step(p.centre, p.radius, p.walls, 1.0);
   ASSERT_TRUE(mixed.cholmod().reduced_precision());
@@ -227,4 +231,22 @@ TEST(MixedPrecision, OneSubstitutionIsAccurateToTheFormat) {
   for (int i = 0; i < nu; ++i) error = std::max(error, std::abs(x32[i] - x64[i]));
   EXPECT_LT(error, 1e-7 * max_abs(x64));
   EXPECT_GT(error, 0);  // it is a different factor
+}
+
+TEST(MixedPrecision, OnByDefaultForLargeFactorsOnly) {
+  const auto p = test::random_packing(600, 71, 0.02, 0.035);
+  FlowEngine e = test::permeameter(1);
+  ASSERT_TRUE(e.settings.mixed_precision);
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_FALSE(e.cholmod().reduced_precision());  // a few 1e4 entries: below the default 2e6
+  const std::vector<double> p_double = e.pressure();
+  e.settings.mixed_precision_min_entries = 0;  // a changed setting rebuilds the factor
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_TRUE(e.cholmod().reduced_precision());
+  const auto [lo, hi] = std::minmax_element(p_double.begin(), p_double.end());
+  for (std::size_t c = 0; c < p_double.size(); ++c)
+    ASSERT_NEAR(e.pressure()[c], p_double[c], e.settings.refinement_tolerance * (*hi - *lo));
+  e.settings.mixed_precision = false;
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_FALSE(e.cholmod().reduced_precision());
 }

@@ -38,6 +38,7 @@ TEST(ParallelSubstitution, SolvesTheSystemSeriallyAndOnTwoThreads) {
       const auto p = test::random_packing(n, 61, 0.02, 0.03);
       FlowEngine e = test::permeameter(1);
       e.settings.mixed_precision = single;
+      e.settings.mixed_precision_min_entries = 0;
       e.step(p.centre, p.radius, p.walls, 1.0);
       auto& solver = const_cast<CholmodSolver&>(e.cholmod());
       ASSERT_EQ(solver.reduced_precision(), single);

@@ -93,6 +93,7 @@ _SUPPORTED = {
     "viscousShear": "viscous_shear",
     # PFV extensions (PEP 8 names: YADE has no equivalent).
     "mixed_precision": "mixed_precision",
+    "mixed_precision_min_entries": "mixed_precision_min_entries",
     "refinement_tolerance": "refinement_tolerance",
 }
 

@@ -507,6 +507,8 @@ def run_trial(kind, info, steady, warnings_seen):
     res['probes'] = [flow.getPorePressure(p) for p in probe_points(L)]
     res['flux'] = [flow.getBoundaryFlux(2 * AXIS), flow.getBoundaryFlux(2 * AXIS + 1)]
     res['core_timer'] = proxy is not None
+    if kind.startswith('pfv'):
+        res['reduced'] = bool(flow.core.reduced_precision_factor())
     del flow, proxy
     O.engines = O.engines[:1]
     O.reset()
@@ -773,6 +775,7 @@ def summarise(timing, memory):
                 # the default (32-bit factor, refined) against the direct double solve, same steps from the same state
                 pp, pd = tr['pfv'][0]['probes'], tr['pfv-double'][0]['probes']
                 row['double_agreement'] = dict(max_dp=max(abs(a - b) / DP for a, b in zip(pp, pd)))
+                row['default_factor'] = '32-bit' if tr['pfv'][0].get('reduced') else 'double'
             # PFV breakdown
             step_stages = ('volumes', 'solve', 'forces')
             br = {'remesh': {}, 'steady': {}}
@@ -927,18 +930,18 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
         w('')
         dbl = [ns for ns in sorted(sizes, key=int) if 'pfv-double' in sizes[ns]]
         if dbl:
-            w('PFV with the double factor (`mixed_precision=False`: every solve a direct double substitution; the '
-              'default keeps the factor in 32 bits and refines each solve to `refinement_tolerance` = 1e-10 of the '
-              'pressure spread), same trials:')
+            w('PFV with the double factor (`mixed_precision=False`: every solve a direct double substitution; by '
+              'default a factor of at least `mixed_precision_min_entries` = 2e6 entries is kept in 32 bits and each '
+              'solve refined to `refinement_tolerance` = 1e-10 of the pressure spread), same trials:')
             w('')
-            w('| N | remesh PFV double | P/Y | flow step PFV double | P/Y | coupled PFV double | (coupled-dry) P/Y '
-              '| default / double flow step | max abs(p default - p double) / dp over 27 probes |')
-            w('|---|---|---|---|---|---|---|---|---|')
+            w('| N | default factor | remesh PFV double | P/Y | flow step PFV double | P/Y | coupled PFV double '
+              '| (coupled-dry) P/Y | default / double flow step | max abs(p default - p double) / dp over 27 probes |')
+            w('|---|---|---|---|---|---|---|---|---|---|')
             for ns in dbl:
                 r = sizes[ns]
                 y, p, d = r['yade'], r['pfv'], r['pfv-double']
-                w('| %s | %s | %s | %s | %s | %s | %s | %.2f | %.1e |'
-                  % (ns, fmt_t(d['remesh']), fmt_r(d['remesh'], y['remesh']), fmt_t(d['flow']),
+                w('| %s | %s | %s | %s | %s | %s | %s | %s | %.2f | %.1e |'
+                  % (ns, r.get('default_factor', '?'), fmt_t(d['remesh']), fmt_r(d['remesh'], y['remesh']), fmt_t(d['flow']),
                      fmt_r(d['flow'], y['flow']), fmt_t(d['coupled']),
                      fmt_r(d['coupled_minus_dry'], y['coupled_minus_dry']), p['flow'] / d['flow'],
                      r.get('double_agreement', {}).get('max_dp', float('nan'))))

@@ -3,8 +3,9 @@ factor, on the permeameter scene of bench/flow_benchmark.py (cached packing, dyn
 
     yade-double -j1 -n -x bench/mixed_precision_dem.py [--size=10000] [--steps=20] [--tolerances=1e-10,1e-8]
 
-From the same saved state it runs S steps with the double factor, then S steps with the single-precision factor
-(`mixed_precision=True`) for each refinement tolerance, and prints per run the median solve stage
+From the same saved state it runs S steps with the double factor (`mixed_precision=False`), then S steps with the
+32-bit factor (`mixed_precision=True`, `mixed_precision_min_entries=0` so that it applies at every size) for each
+refinement tolerance, and prints per run the median solve stage
 (`core.step_times()['solve']`), how many steps took 1, 2, ... refinement passes, the contraction estimate, the median
 step-to-step change of the pressures, and the largest |p_mixed - p_double| / max|p_double| over the steps (the DEM is
 deterministic at -j1, so both runs see the same positions up to the feedback of that difference). Unlike
@@ -26,6 +27,8 @@ def run(steps, mixed, tolerance=None):
     O.loadTmp('bench')
     flow = fb.make_engine('pfv')
     flow.mixed_precision = mixed
+    if mixed:
+        flow.mixed_precision_min_entries = 0  # the 32-bit factor at every size (the default keeps small ones double)
     if tolerance is not None:
         flow.refinement_tolerance = tolerance
     fb.insert_engine(flow)

@@ -6,7 +6,7 @@ doc/model.md ("Solving G p = b"), on the cached benchmark packing (made by bench
 1. ordering reuse: CHOLMOD analysis with a fresh METIS ordering and with the ordering carried over from the previous
    mesh, for the same positions and after moving every sphere at random by 0.5 % and 2 % of the mean radius
    (fill per unknown, kept or not, share of new cells);
-2. mixed precision: solve time of the double and of the refined single-precision factor in a loop, with the factor
+2. mixed precision: solve time of the double and of the refined 32-bit factor in a loop, with the factor
    in cache and evicted before every solve, refinement passes, contraction estimate, largest pressure difference /
    max|p|;
 3. force write to YADE: the engine's bridge (Vector3 written in place) against addF with tuples from Python;
@@ -56,6 +56,7 @@ def engine(mixed=False, reuse=True):
     e.slip_boundary = False
     e.mesh_update_interval = 10 ** 9
     e.mixed_precision = mixed
+    e.mixed_precision_min_entries = 0  # with mixed: the 32-bit factor whatever the size
     e.reuse_ordering = reuse
     return e
 

@@ -30,8 +30,8 @@ Options (each an engine, all stepped in lockstep on the same positions)
   solver sweep   Gauss-Seidel/SOR (useSolver 0, relax 1.9, tolerance = max|dp|/max|p| per sweep) and incomplete-
                  Cholesky preconditioned CG (useSolver 1, warm-started, tolerance = relative residual) at
                  tolerances 1e-3 ... 1e-9, on the remesh schedule mesh_update_interval = SOLVER_INTERVAL
-  mixed          CHOLMOD with mixed_precision on (the factor rounded to float, each solve refined in double from
-                 the previous pressures until the estimated error < refinement_tolerance * max|p|): at the default
+  mixed          CHOLMOD with mixed_precision on (the factor in 32 bits, each solve refined in double from
+                 the previous pressures until the estimated error < refinement_tolerance * the pressure spread): at the default
                  refinement_tolerance 1e-10 and at 1e-6; in the oedometers on the interval-10 and defTolerance-0.01
                  schedules, and compared also with the double CHOLMOD on the same schedule ("same mesh")
   background     CHOLMOD with background_remesh on (the mesh is built on a second thread); the driver waits for it
@@ -149,6 +149,7 @@ def make_engine(pfv, solver=3, tol=1e-6, interval=1, def_tol=0.0, background=Fal
                 mixed=False, ref_tol=None):
     e = pfv.Engine()
     e.mixed_precision = mixed
+    e.mixed_precision_min_entries = 0  # with mixed: the 32-bit factor at the study's sizes too
     if ref_tol is not None:
         e.refinement_tolerance = ref_tol
     e.viscosity = VISCOSITY

@@ -104,7 +104,13 @@ PYBIND11_MODULE(_core, m) {
   py::class_<YadeForceBridge>(m, "YadeForceBridge")
       .def(py::init<py::object, const py::array_t<long long>&, const py::array_t<long long>&>(),
            py::arg("vector3_type"), py::arg("ids"), py::arg("rows"))
-      .def("apply", &YadeForceBridge::apply, py::arg("add"), py::arg("forces"))
+      .def("apply", [](const YadeForceBridge& b, py::handle add, const FlowEngine& engine) {
+             const std::vector<Vec3>& f = engine.forces();
+             static_assert(sizeof(Vec3) == 3 * sizeof(double), "rows of three doubles");
+             b.apply(add, f.empty() ? nullptr : f.front().data(), f.size());
+           }, py::arg("add"), py::arg("engine"), "The forces of an Engine (its forces(), without the copy).")
+      .def("apply", py::overload_cast<py::handle, const YadeForceBridge::Forces&>(&YadeForceBridge::apply, py::const_),
+           py::arg("add"), py::arg("forces"))
       .def_property_readonly("writes_in_place", &YadeForceBridge::writes_in_place)
       .def_property_readonly("calls_yade_directly", &YadeForceBridge::calls_yade_directly)
       .def("__len__", &YadeForceBridge::size);

@@ -112,10 +112,15 @@ void* YadeForceBridge::direct_target(py::handle add) const {
 }
 
 void YadeForceBridge::apply(py::handle add, const Forces& forces) const {
-  const auto f = forces.unchecked<2>();
-  const py::ssize_t n = f.shape(0);
-  if (f.ndim() != 2 || f.shape(1) != 3 || std::any_of(rows_.begin(), rows_.end(), [n](py::ssize_t r) { return r >= n; }))
+  if (forces.ndim() != 2 || forces.shape(1) != 3) throw py::value_error("force array must have shape (n, 3)");
+  apply(add, forces.data(), static_cast<std::size_t>(forces.shape(0)));
+}
+
+void YadeForceBridge::apply(py::handle add, const double* forces, std::size_t count) const {
+  const auto n = static_cast<py::ssize_t>(count);
+  if (std::any_of(rows_.begin(), rows_.end(), [n](py::ssize_t r) { return r >= n; }))
     throw py::value_error("force array does not match the bodies of the bridge");
+  const auto f = [forces](py::ssize_t row, int axis) { return forces[3 * row + axis]; };
 #ifdef PFV_HAVE_BOOST_PYTHON
   if (void* container = direct_target(add)) {
     try {

@@ -27,6 +27,8 @@ class YadeForceBridge {
                   const pybind11::array_t<long long>& rows);
   // add(ids[i], forces[rows[i]]) for every i; add is a bound O.forces.addF.
   void apply(pybind11::handle add, const Forces& forces) const;
+  // The same from count rows of three doubles (the engine's own force array: no copy to numpy).
+  void apply(pybind11::handle add, const double* forces, std::size_t count) const;
   bool writes_in_place() const { return !storage_.empty(); }
   // Whether apply(O.forces.addF, ...) calls YADE's force_add directly.
   bool calls_yade_directly() const { return force_add_ != nullptr; }

@@ -142,5 +142,26 @@ bad = _core.YadeForceBridge(Vector3, np.array([n_bodies + 5], dtype=np.int64), n
 message = raises(IndexError, lambda: bad.apply(O.forces.addF, np.zeros((1, 3))))
 check(message is not None and "out of range" in message, f"a body id beyond the scene: YADE's IndexError ({message})")
 
+# The engine's overload reads the C++ force array itself (no numpy copy): the same sums.
+scenes.build_permeameter(num=1000, frozen=False)
+spheres = [b for b in O.bodies if isinstance(b.shape, Sphere)]
+pos = np.array([tuple(b.state.pos) for b in spheres])
+rad = np.array([b.shape.radius for b in spheres])
+low, high = (pos - rad[:, None]).min(0) - 1e-3, (pos + rad[:, None]).max(0) + 1e-3
+engine = _core.Engine()
+engine.bnd_is_pressure = [False, False, True, True, False, False]
+engine.bnd_value = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
+engine.step(pos, rad, [low[0], high[0], low[1], high[1], low[2], high[2]], 1e-4)
+sphere_bridge = _core.YadeForceBridge(Vector3, np.array([b.id for b in spheres], dtype=np.int64),
+                                      np.arange(len(spheres), dtype=np.int64))
+from_engine = forces_after(lambda add: sphere_bridge.apply(add, engine))
+from_array = forces_after(lambda add: sphere_bridge.apply(add, engine.forces()))
+check(np.array_equal(from_engine, from_array) and np.abs(from_engine).max() > 0,
+      "apply(addF, engine) writes what apply(addF, engine.forces()) writes")
+message = raises(ValueError, lambda: bridge.apply(O.forces.addF, engine))  # one force row per body of the scene
+check(message is None, "an engine with enough force rows is accepted")
+message = raises(ValueError, lambda: bad.apply(O.forces.addF, _core.Engine()))
+check(message is not None and "does not match" in message, f"an engine without forces: ValueError ({message})")
+
 print(f"{len(failures)} failed")
 sys.exit(1 if failures else 0)

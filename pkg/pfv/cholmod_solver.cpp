@@ -181,8 +181,7 @@ namespace {
 // in place, to its lower trapezoid: column j keeps rows j..nsrow-1. Returns where each block
 // now starts. A block never moves to a higher address, so copying in increasing order only
 // overwrites entries already moved.
-template <class Real>
-std::vector<long> compact_to_trapezoids(Real* v, const cholmod_factor& f) {
+std::vector<long> compact_to_trapezoids(double* v, const cholmod_factor& f) {
   const auto* super = static_cast<const int*>(f.super);
   const auto* pi = static_cast<const int*>(f.pi);
   const auto* px = static_cast<const int*>(f.px);
@@ -192,8 +191,8 @@ std::vector<long> compact_to_trapezoids(Real* v, const cholmod_factor& f) {
     start[s] = out;
     const long nscol = super[s + 1] - super[s], nsrow = pi[s + 1] - pi[s];
     for (long j = 0; j < nscol; ++j) {
-      const Real* from = v + px[s] + j * nsrow + j;
-      if (v + out != from) std::memmove(v + out, from, (nsrow - j) * sizeof(Real));
+      const double* from = v + px[s] + j * nsrow + j;
+      if (v + out != from) std::memmove(v + out, from, (nsrow - j) * sizeof(double));
       out += nsrow - j;
     }
   }

@@ -192,9 +192,12 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
         const int c = system.unknown_cell[u];
         solution_[u] = trend ? 2 * next_pressure_[c] - pressure_before_[c] : next_pressure_[c];
       }
-      if (!linear_.refinement.solve(system, *linear_.cholmod, rhs_, solution_, settings.refinement_tolerance,
-                                    settings.max_refinement_passes)) {
-        linear_.cholmod->promote_to_double(system);  // G too ill-conditioned for a float factor
+      if (linear_.refinement.contraction() < 0 && contraction_seen_ > 0) linear_.refinement.seed(contraction_seen_);
+      const bool converged = linear_.refinement.solve(system, *linear_.cholmod, rhs_, solution_,
+                                                      settings.refinement_tolerance, settings.max_refinement_passes);
+      if (converged) contraction_seen_ = std::max(contraction_seen_, linear_.refinement.contraction());
+      if (!converged) {
+        linear_.cholmod->promote_to_double(system);  // G too ill-conditioned for the 32-bit factor
         linear_.cholmod->solve(rhs_, solution_);
       }
       gs_iterations_ = linear_.refinement.passes();

@@ -116,6 +116,7 @@ class FlowEngine {
   std::vector<Vec3> force_;
   std::vector<double> next_volume_, next_pressure_;  // scratch of the step being computed
   std::vector<double> pressure_before_;  // the step before pressure_'s, on this mesh (refinement only)
+  double contraction_seen_ = -1;          // the largest refinement contraction of this engine's factors
   std::vector<Vec3> next_force_;
   std::vector<Vec3> shear_force_, next_shear_;  // only with viscous_shear
   std::vector<Vec3> centres_prev_;

@@ -60,7 +60,7 @@ bool Refinement::solve(const PressureSystem& s, CholmodSolver& m, const std::vec
                        std::vector<double>& x, double tolerance, int max_passes) {
   // Corrections this small (relative to x) are round-off: their ratios say nothing about rho.
   constexpr double kRoundOff = 1e-13;
-  if (rho_ < 0) rho_ = std::max(kSafety * estimate_contraction(s, m), 1e-12);
+  if (rho_ < 0) rho_ = seed_ > 0 ? seed_ : std::max(kSafety * estimate_contraction(s, m), 1e-12);
   if (rho_ >= 0.5) return false;
   double previous = 0;
   passes_ = 0;

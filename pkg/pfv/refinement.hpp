@@ -25,6 +25,12 @@ class Refinement {
  public:
   // Forget rho (a new factor).
   void reset() { rho_ = -1; }
+  // rho measured on an earlier factor of the same engine (the previous mesh), taken as this
+  // factor's instead of the power iterations, which cost one residual and one substitution each
+  // at every remesh. Consecutive meshes of one packing contract alike, and the first solve of a
+  // mesh starts cold (two passes or more), so a pass contracting less than the seed raises rho
+  // as below. (One power iteration is no check: from the fixed start its ratio is 20x rho.)
+  void seed(double rho) { seed_ = rho; }
   // x holds the starting guess on entry. Returns false if the passes stop contracting
   // (rho >= 1/2: G is too ill-conditioned for the rounded factor) or max_passes is reached;
   // x is then unspecified.
@@ -40,7 +46,7 @@ class Refinement {
   double estimate_contraction(const PressureSystem& system, CholmodSolver& factor);
 
   std::vector<double> residual_, correction_;
-  double rho_ = -1;
+  double rho_ = -1, seed_ = -1;
   int passes_ = 0;
 };
 

@@ -6,9 +6,9 @@
 // networks measured (10 000 to 50 000 spheres), and it starts from pressures that differ from
 // the new ones by about the change of one DEM step (1e-4 to 4e-4 of their spread): one pass
 // meets a tolerance of 1e-10 while it reads half the bytes of a double substitution (plus G
-// once, for the residual). rho is estimated once per
-// factor, before its first solve, by a few power iterations on I - M^-1 G (times a safety
-// factor: the power iteration approaches rho from below); a solve stops as soon as the
+// once, for the residual). rho is estimated before a factor's first solve by a few power
+// iterations on I - M^-1 G (times a safety factor: the power iteration approaches rho from
+// below), unless seeded from an earlier factor (seed()); a solve stops as soon as the
 // estimated error rho / (1 - rho) * |correction| is below the tolerance, relative to the spread
 // max x - min x of the solution (max |x| if it is uniform).
 // A pass that contracts less than rho raises it. (The ratio of the first two corrections is

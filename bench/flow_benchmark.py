@@ -1217,6 +1217,8 @@ def driver(opts, argv):
         child_opts.append('--no-oedometer')
     if not opts['multithread']:
         child_opts.append('--no-multithread')
+    if not opts['double']:
+        child_opts.append('--no-double')
     if opts['quick']:
         child_opts.append('--quick')
     timing = {}

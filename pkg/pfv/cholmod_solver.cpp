@@ -136,9 +136,7 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
   if (!ordering_given_)
     metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
   numeric_factorization(s);
-  reduced_ = precision == FactorPrecision::kScaled32;
-  min_scaled_entries_ = min_scaled_entries;
-  plan_substitution(s);
+  plan_substitution(s, precision == FactorPrecision::kScaled32 ? min_scaled_entries : kNever);
 }
 
 void CholmodSolver::numeric_factorization(const PressureSystem& s) {
@@ -166,10 +164,9 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
 
 void CholmodSolver::promote_to_double(const PressureSystem& s) {
   if (!factor_ || !reduced_precision()) return;
-  reduced_ = false;
   std::vector<double>().swap(scale_);
   numeric_factorization(s);  // on the symbolic factor kept from the analysis; overwrites the 32-bit values
-  plan_substitution(s);
+  plan_substitution(s, kNever);
 }
 
 namespace {
@@ -236,7 +233,7 @@ bool scale_to_int32(double* v, const cholmod_factor& f, const std::vector<long>&
 
 }  // namespace
 
-void CholmodSolver::plan_substitution(const PressureSystem& system) {
+void CholmodSolver::plan_substitution(const PressureSystem& system, double min_scaled_entries) {
   auto* f = static_cast<cholmod_factor*>(factor_);
   if (!f->is_super || !f->is_ll) {  // CHOLMOD_SUPERNODAL is requested in the constructor
     release();
@@ -252,15 +249,14 @@ void CholmodSolver::plan_substitution(const PressureSystem& system) {
   // From here on CHOLMOD's routines must not read the values (solve_serial never calls them).
   auto* v = static_cast<double*>(f->x);
   trapezoid_start_ = compact_to_trapezoids(v, *f);
-  if (reduced_ && trapezoid_start_.back() < min_scaled_entries_) reduced_ = false;  // small: double pays
-  if (reduced_ && !scale_to_int32(v, *f, trapezoid_start_, scale_)) {
+  // Small factors stay double: they are served from the caches, where 32 bits gain nothing.
+  if (trapezoid_start_.back() >= min_scaled_entries && !scale_to_int32(v, *f, trapezoid_start_, scale_)) {
     std::vector<double>().swap(scale_);  // stay double: factorise again, the values were overwritten
-    reduced_ = false;
     numeric_factorization(system);
     v = static_cast<double*>(f->x);
     trapezoid_start_ = compact_to_trapezoids(v, *f);
   }
-  if (reduced_) {
+  if (reduced_precision()) {
     view.scaled = reinterpret_cast<const std::int32_t*>(v);
     view.scale = scale_.data();
   } else {

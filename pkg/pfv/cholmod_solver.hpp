@@ -2,6 +2,7 @@
 // forward/back substitution each step, into buffers allocated at factorisation.
 // Owns every CHOLMOD object it creates (YADE leaked factors here).
 #pragma once
+#include <limits>
 #include <vector>
 
 #include "parallel_substitution.hpp"
@@ -86,14 +87,15 @@ class CholmodSolver {
   void release();
   void solve_on(const std::vector<double>& rhs, std::vector<double>& x, bool threads);
   void numeric_factorization(const PressureSystem& system);
-  void plan_substitution(const PressureSystem& system);
+  // Compacts the factor, converts it to kScaled32 if it has at least min_scaled_entries entries
+  // (kNever: stays double), and plans the substitution.
+  void plan_substitution(const PressureSystem& system, double min_scaled_entries);
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
   struct Common;
   Common* common_;
   bool openmp_teams_ = false;
   void* factor_ = nullptr;  // cholmod_factor*
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
-  bool reduced_ = false;       // kScaled32 asked for (until a fallback to double)
-  double min_scaled_entries_ = 0;
   std::vector<double> scale_;  // per column (elimination order) with kScaled32; empty in double
   ParallelSubstitution parallel_;
   bool metis_used_ = false;

@@ -24,8 +24,8 @@ struct EngineSettings {
   // (max p - min p) over the unknowns. Falls back to the double factor if G is too
   // ill-conditioned for it. Only for factors of at least mixed_precision_min_entries stored
   // entries: a smaller double factor is served from the caches, and the residual of each pass
-  // costs what the 32-bit factor saves (parity at 3 000 spheres, 1.7e6 entries; 20 % faster at
-  // 50 000, doc/benchmarks.md).
+  // costs what the 32-bit factor saves (bench/mixed_precision_dem.py: parity at 3 000 spheres,
+  // whose factor holds 1.7e6 entries; 20 % faster at 50 000; doc/benchmarks.md).
   bool mixed_precision = true;
   double mixed_precision_min_entries = 2e6;
   double refinement_tolerance = 1e-10;

@@ -166,6 +166,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     const int c = linear_.imposed_flux_cells[i];
     if (c >= 0 && system.unknown[c] >= 0) rhs_[system.unknown[c]] += bc.imposed_flux[i].value;
   }
+  bool refined = false;  // solved by refinement with the 32-bit factor: keep the pressures for the next start
   if (nu == 0) {
     // every cell has an imposed pressure: nothing to solve
   } else if (settings.use_solver == 0) {
@@ -195,8 +196,10 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
       if (linear_.refinement.contraction() < 0 && contraction_seen_ > 0) linear_.refinement.seed(contraction_seen_);
       const bool converged = linear_.refinement.solve(system, *linear_.cholmod, rhs_, solution_,
                                                       settings.refinement_tolerance, settings.max_refinement_passes);
-      if (converged) contraction_seen_ = std::max(contraction_seen_, linear_.refinement.contraction());
-      if (!converged) {
+      if (converged) {
+        contraction_seen_ = std::max(contraction_seen_, linear_.refinement.contraction());
+        refined = true;
+      } else {
         linear_.cholmod->promote_to_double(system);  // G too ill-conditioned for the 32-bit factor
         linear_.cholmod->solve(rhs_, solution_);
       }
@@ -235,7 +238,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     if (!next_force_[v].allFinite()) throw std::domain_error("non-finite fluid force on vertex " + std::to_string(v));
 
   std::swap(volume_, next_volume_);
-  if (settings.use_solver == 3 && linear_.cholmod->reduced_precision())
+  if (refined)
     std::swap(pressure_before_, pressure_);  // kept for the next start; its buffer becomes scratch
   else if (!pressure_before_.empty())
     std::vector<double>().swap(pressure_before_);

@@ -38,6 +38,10 @@ void CholmodSolver::release() {
   cholmod_common* c = &common_->c;
   if (factor_) {
     auto* f = static_cast<cholmod_factor*>(factor_);
+    if (f->x == values_.get()) {  // ours: CHOLMOD must not free it (it frees nothing at null)
+      f->x = nullptr;
+      f->xtype = CHOLMOD_PATTERN;
+    }
     cholmod_free_factor(&f, c);
   }
   factor_ = nullptr;
@@ -135,8 +139,28 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
   factor_ = f;
   if (!ordering_given_)
     metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
+  lend_values(f);
   numeric_factorization(s);
   plan_substitution(s, precision == FactorPrecision::kScaled32 ? min_scaled_entries : kNever);
+}
+
+void CholmodSolver::lend_values(void* factor) {
+  // What cholmod_change_factor does to a symbolic supernodal factor before the numeric
+  // factorisation, with our storage instead of a new block: the values are undefined until
+  // the factorisation, which clears each supernode before assembling it.
+  auto* f = static_cast<cholmod_factor*>(factor);
+  if (!f->is_super || f->xtype != CHOLMOD_PATTERN) return;  // CHOLMOD allocates, as without us
+  if (value_capacity_ < f->xsize) {
+    values_.reset();  // the old storage first: one block at a time
+    value_capacity_ = 0;
+    const std::size_t capacity = f->xsize + f->xsize / 8;
+    values_.reset(new double[capacity]);  // uninitialised: no page is touched here
+    value_capacity_ = capacity;
+  }
+  f->x = values_.get();
+  f->xtype = CHOLMOD_REAL;
+  f->dtype = CHOLMOD_DOUBLE;
+  f->minor = f->n;
 }
 
 void CholmodSolver::numeric_factorization(const PressureSystem& s) {

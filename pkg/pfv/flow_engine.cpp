@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 #include "gauss_seidel_solver.hpp"
 #include "pore_mesh.hpp"
@@ -60,6 +61,13 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, int bc_version) {
   ++remesh_count_;
 }
 
+std::unique_ptr<CholmodSolver> FlowEngine::released_solver() {
+  // The engine keeps an (empty) solver whatever happens to the new system.
+  auto solver = std::exchange(linear_.cholmod, std::make_unique<CholmodSolver>());
+  solver->release();
+  return solver;
+}
+
 void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double>& radii,
                       const BoxWalls& walls, double dt) {
   if (!(dt > 0 && std::isfinite(dt))) bad_input("time step must be positive and finite");
@@ -110,9 +118,8 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
       // step starts the remesh over; the last results stay readable meanwhile.
       remesh_requested_ = true;
       const auto ordering = linear_.ordering;  // survives the release of the old factor
-      linear_.cholmod = std::make_unique<CholmodSolver>();
       linear_.pcg = PcgSolver{};
-      LinearSystem l = build_linear_system(m, bc, settings, dt, ordering.get());
+      LinearSystem l = build_linear_system(m, bc, settings, dt, ordering.get(), released_solver());
       adopt(std::move(m), std::move(l), bc_version_);
       strain_ = 0;
       steps_since_remesh_ = 0;
@@ -130,7 +137,8 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   if (linear_bc_version_ != bc_version_ || solver_missing || storage_stale) {
     // New boundary conditions, a solver chosen after the last remesh, or a new dt or bulk
     // modulus with a compressible fluid.
-    linear_ = build_linear_system(*mesh_, bc, settings, dt, linear_.ordering.get());
+    const auto ordering = linear_.ordering;
+    linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver());
     linear_bc_version_ = bc_version_;
   }
 

@@ -99,6 +99,9 @@ class FlowEngine {
 
  private:
   using Remesh = std::pair<PoreMesh, LinearSystem>;
+  // The current factor freed, its solver (and the storage of its values) handed over for the
+  // next factorisation: peak memory one factor, and no new pages to fault in.
+  std::unique_ptr<CholmodSolver> released_solver();
   struct Pending {
     std::future<Remesh> result;
     int bc_version;

@@ -52,8 +52,10 @@ PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<dou
 }
 
 LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc,
-                                 const EngineSettings& settings, double dt, const CellOrdering* previous) {
+                                 const EngineSettings& settings, double dt, const CellOrdering* previous,
+                                 std::unique_ptr<CholmodSolver> solver) {
   LinearSystem l;
+  if (solver) l.cholmod = std::move(solver);
   l.dt = dt;
   l.mixed_precision = settings.mixed_precision;
   l.mixed_precision_min_entries = settings.mixed_precision_min_entries;

@@ -54,9 +54,11 @@ PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<dou
                          const BoxWalls& walls, const EngineSettings& settings);
 
 // Throws std::domain_error if the system is singular. previous: the ordering of the last
-// factorisation, tried first when settings.reuse_ordering (null: compute one).
+// factorisation, tried first when settings.reuse_ordering (null: compute one). solver: a
+// released CholmodSolver to factorise with, whose storage is then reused (null: a new one).
 LinearSystem build_linear_system(const PoreMesh& mesh, const BoundaryConditions& bc,
                                  const EngineSettings& settings, double dt,
-                                 const CellOrdering* previous = nullptr);
+                                 const CellOrdering* previous = nullptr,
+                                 std::unique_ptr<CholmodSolver> solver = nullptr);
 
 }  // namespace pfv

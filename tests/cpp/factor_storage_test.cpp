@@ -1,0 +1,96 @@
+// The storage of the factor's values outlives the factor: a solver factorising again reuses it,
+// and what is left in it from an earlier factor (double or 32-bit) changes nothing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "flow_engine.hpp"
+#include "test_packings.hpp"
+
+using namespace pfv;
+
+namespace {
+
+// The assembled permeameter system of a random packing.
+PressureSystem system_of(int n, unsigned seed) {
+  const auto p = test::random_packing(n, seed, 0.02, 0.035);
+  FlowEngine e = test::permeameter(1);
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  return e.system();
+}
+
+std::vector<double> rhs(int n) {
+  std::vector<double> b(n);
+  for (int i = 0; i < n; ++i) b[i] = std::sin(0.37 * i + 1);
+  return b;
+}
+
+std::vector<double> solve(CholmodSolver& s, const std::vector<double>& b) {
+  std::vector<double> x;
+  s.solve(b, x);
+  return x;
+}
+
+}  // namespace
+
+TEST(FactorStorage, ReusedStorageGivesTheFreshSolution) {
+  const PressureSystem small = system_of(300, 3), large = system_of(700, 4);
+  ASSERT_LT(small.n_unknowns(), large.n_unknowns());
+  const auto b = rhs(small.n_unknowns());
+
+  CholmodSolver fresh;
+  fresh.factorize(small, Ordering::kAmd);
+  const auto expected = solve(fresh, b);
+
+  CholmodSolver reused;
+  EXPECT_EQ(reused.value_capacity(), 0u);
+  reused.factorize(large, Ordering::kAmd, FactorPrecision::kScaled32, {}, 0);  // leaves 32-bit entries behind
+  ASSERT_TRUE(reused.reduced_precision());
+  const std::size_t capacity = reused.value_capacity();
+  EXPECT_GT(capacity, 0u);
+  reused.release();
+  EXPECT_FALSE(reused.ready());
+  EXPECT_EQ(reused.value_capacity(), capacity);  // kept
+
+  reused.factorize(small, Ordering::kAmd);
+  EXPECT_EQ(reused.value_capacity(), capacity);  // fits: no new block
+  EXPECT_EQ(solve(reused, b), expected);         // to the bit
+
+  // Growing: the larger factor needs more than the small one left.
+  CholmodSolver grown;
+  grown.factorize(small, Ordering::kAmd);
+  const std::size_t before = grown.value_capacity();
+  grown.release();
+  grown.factorize(large, Ordering::kAmd);
+  EXPECT_GT(grown.value_capacity(), before);
+  CholmodSolver reference;
+  reference.factorize(large, Ordering::kAmd);
+  const auto bl = rhs(large.n_unknowns());
+  EXPECT_EQ(solve(grown, bl), solve(reference, bl));
+}
+
+TEST(FactorStorage, RemeshesFactoriseInTheStorageOfThePreviousFactor) {
+  auto p = test::random_packing(600, 11, 0.02, 0.035);
+  FlowEngine e = test::permeameter(1);
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  const std::size_t capacity = e.cholmod().value_capacity();
+  ASSERT_GT(capacity, 0u);
+  for (int k = 0; k < 3; ++k) {
+    for (auto& c : p.centre) c += Vec3(1e-6, -1e-6, 0);
+    e.request_remesh();
+    e.step(p.centre, p.radius, p.walls, 1e-3);
+    EXPECT_EQ(e.remesh_count(), k + 2);
+    EXPECT_EQ(e.cholmod().value_capacity(), capacity);  // the same block (grown only if it no longer fits)
+    ASSERT_TRUE(e.cholmod().ready());
+  }
+  // And the pressures are those of a new engine's first factor (in fresh storage), on the same
+  // positions (unmoved since the last step: no volume change in either) and the same ordering.
+  FlowEngine fresh = test::permeameter(1);
+  fresh.settings.reuse_ordering = false;
+  e.settings.reuse_ordering = false;
+  e.request_remesh();
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  fresh.step(p.centre, p.radius, p.walls, 1e-3);
+  ASSERT_EQ(e.pressure().size(), fresh.pressure().size());
+  for (std::size_t c = 0; c < e.pressure().size(); ++c) EXPECT_EQ(e.pressure()[c], fresh.pressure()[c]) << c;
+}

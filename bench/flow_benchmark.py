@@ -427,6 +427,13 @@ def _td_diff(a, b):
     return {k: b.get(k, 0.0) - a.get(k, 0.0) for k in b}
 
 
+def _dem_exec(flow):
+    """Seconds of execTime of every engine but the flow engine so far (O.timingEnabled): the DEM
+    part of a step, to compare the DEM of the coupled steps with the dry steps."""
+    from yade import O
+    return sum(e.execTime for e in O.engines if e is not flow) * 1e-9
+
+
 def run_trial(kind, info, steady, warnings_seen):
     """One trial on the saved permeameter scene. kind in yade, pfv, dry."""
     import warnings
@@ -438,12 +445,15 @@ def run_trial(kind, info, steady, warnings_seen):
     if kind == 'dry':
         for _ in range(WINDOW):
             O.step()
-        wall = []
+        wall, dem = [], []
         for _ in range(steady):
+            d0 = _dem_exec(None)
             t0 = time.perf_counter()
             O.step()
             wall.append(time.perf_counter() - t0)
+            dem.append(_dem_exec(None) - d0)
         res['steady_wall'] = wall
+        res['steady_dem'] = dem
         res['vmax'] = max(b.state.vel.norm() for b in O.bodies)
         O.reset()
         return res
@@ -456,12 +466,14 @@ def run_trial(kind, info, steady, warnings_seen):
 
         def step(record):
             e0 = flow.execTime
+            d0 = _dem_exec(flow)
             t0 = time.perf_counter()
             O.step()
             wall = time.perf_counter() - t0
             ex = (flow.execTime - e0) * 1e-9
             record['wall'].append(wall)
             record['exec'].append(ex)
+            record.setdefault('dem', []).append(_dem_exec(flow) - d0)
             if kind.startswith('pfv'):
                 core = flow.core
                 record.setdefault('step_times', []).append(dict(core.step_times()))
@@ -745,6 +757,8 @@ def summarise(timing, memory):
             row = dict(n=int(ns))
             dry = [median(x['steady_wall']) for x in tr['dry']]
             row['dry'] = median(dry)
+            dry_dem = [median(x['steady_dem']) for x in tr['dry'] if x.get('steady_dem')]
+            row['dry_dem'] = median(dry_dem) if dry_dem else None
             row['dry_range'] = (min(dry), max(dry)) if dry else None
             row['vmax'] = {k: max([x.get('vmax', float('nan')) for x in tr[k]] or [float('nan')]) for k in tr}
             for kind in [k for k in ('yade', 'pfv', 'pfv-double') if tr.get(k)]:
@@ -761,6 +775,8 @@ def summarise(timing, memory):
                                  remesh_range=(min(remesh), max(remesh)),
                                  cells=tr[kind][0]['n_cells'] if tr[kind] else None)
                 row[kind]['coupled_minus_dry'] = row[kind]['coupled'] - row['dry']
+                dem = [median(x['steady']['dem']) for x in tr[kind] if x['steady'].get('dem')]
+                row[kind]['dem'] = median(dem) if dem else None
             # pressure agreement (first round of each engine: same number of steps from the same state)
             if tr['yade'] and tr['pfv']:
                 py, pp = tr['yade'][0]['probes'], tr['pfv'][0]['probes']
@@ -954,6 +970,13 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
                 fmt_t(sizes[ns]['pfv']['flow_range'][0]), fmt_t(sizes[ns]['pfv']['flow_range'][1]))
             for ns in sorted(sizes, key=int)) + '.')
         w('')
+        if all(sizes[ns].get('dry_dem') is not None for ns in sizes):
+            w('DEM engines per steady step (execTime of every engine but the flow engine; medians as above; the '
+              'difference between "coupled - dry" and the flow step): ' + '; '.join(
+                  'N=%s dry %s, with YADE %s, with PFV %s' % (
+                      ns, fmt_t(sizes[ns]['dry_dem']), fmt_t(sizes[ns]['yade'].get('dem')),
+                      fmt_t(sizes[ns]['pfv'].get('dem'))) for ns in sorted(sizes, key=int)) + '.')
+            w('')
         ld = summ[t].get('load') or (None, None)
         if ld[0]:
             w('Load average (1, 5, 15 min) of the machine when this yade process started: %s; when it ended: %s.  '

@@ -1,7 +1,7 @@
 """Stage measurements behind doc/benchmarks.md ("What each optimisation gained", this session's table) and
 doc/model.md ("Solving G p = b"), on the cached benchmark packing (made by bench/flow_benchmark.py).
 
-    yade-double -j1 -n -x bench/solver_stages.py [--size=10000]
+    yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6]
 
 1. ordering reuse: CHOLMOD analysis with a fresh METIS ordering and with the ordering carried over from the previous
    mesh, for the same positions and after moving every sphere at random by 0.5 % and 2 % of the mean radius
@@ -15,13 +15,15 @@ doc/model.md ("Solving G p = b"), on the cached benchmark packing (made by bench
 5. successive forced remeshes of one pfv.FlowEngine on the settled permeameter scene of bench/flow_benchmark.py (the
    benchmark's "remesh" is the second mesh of an engine): C++ stage times per remesh, and the factorisation with
    CHOLMOD's own OpenMP teams (4 threads, its compiled-in CHOLMOD_OMP_NUM_THREADS) against the engine's default, which
-   runs them on the calling thread (`flow.core.cholmod_openmp_teams`);
+   runs them on the calling thread (`flow.core.cholmod_openmp_teams`), and the page faults of each remesh step
+   (getrusage: the factor's storage is reused from the second mesh on);
 6. the collective viscous limit of a first mesh (drained top, viscosity 10, density 2600): the engine's Arnoldi
    (at most 40 operator applications) against power iteration from the same fixed start, 40 and 120 iterations.
 Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers;
 section 2 imitates the DEM's eviction of the factor).
 """
 import os
+import resource
 import sys
 import time
 
@@ -173,11 +175,13 @@ def remesh_sequence(n):
     for serial in (True, True, True, False, True):
         core.cholmod_openmp_teams = not serial
         flow.updateTriangulation = True
+        faults = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
         O.step()
+        faults = resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults
         t = core.remesh_times()
-        print('   mesh %d, CHOLMOD OpenMP regions %s: %s' % (
+        print('   mesh %d, CHOLMOD OpenMP regions %s: %s; %d page faults' % (
             core.remesh_count, 'on the calling thread' if serial else 'in CHOLMOD teams of 4',
-            ', '.join('%s %.1f ms' % (k, 1e3 * t[k]) for k in keys)))
+            ', '.join('%s %.1f ms' % (k, 1e3 * t[k]) for k in keys), faults))
     O.engines = O.engines[:1]
 
 
@@ -212,11 +216,17 @@ def main():
     L = meta.get('box', fb.box_side(n))
     walls = [0, L, 0, L, 0, L]
     print('solver_stages: N = %d, packing %s' % (n, fb.packing_path(n)))
-    ordering(pos, rad, walls)
-    mixed_precision(pos, rad, walls)
-    exchange(pos, rad, L)
-    collective_limit(pos, rad, walls)
-    remesh_sequence(n)
+    sections = option('sections', '1,2,3,4,5,6').split(',')
+    if '1' in sections:
+        ordering(pos, rad, walls)
+    if '2' in sections:
+        mixed_precision(pos, rad, walls)
+    if '3' in sections or '4' in sections:
+        exchange(pos, rad, L)
+    if '6' in sections:
+        collective_limit(pos, rad, walls)
+    if '5' in sections:
+        remesh_sequence(n)
     return 0
 
 

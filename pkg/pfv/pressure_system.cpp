@@ -113,7 +113,39 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
     s.row[pos] = u;
     s.value[pos] = s.diagonal[c];
   }
+  index_rows(s);
   return s;
+}
+
+void index_rows(PressureSystem& s) {
+  const int nu = s.n_unknowns();
+  std::vector<int> count(nu, 0);
+  for (int j = 0; j < nu; ++j)
+    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e)
+      if (s.row[e] != j) {
+        ++count[j];
+        ++count[s.row[e]];
+      }
+  const int w = nu > 0 ? *std::max_element(count.begin(), count.end()) : 0;
+  s.row_width = w;
+  s.row_column.resize(static_cast<std::size_t>(nu) * w);
+  s.row_value.assign(static_cast<std::size_t>(nu) * w, 0.0);
+  s.row_diagonal.assign(nu, 0.0);
+  for (int u = 0; u < nu; ++u) std::fill_n(s.row_column.begin() + static_cast<std::size_t>(u) * w, w, u);
+  std::fill(count.begin(), count.end(), 0);
+  for (int j = 0; j < nu; ++j)
+    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e) {
+      const int i = s.row[e];
+      if (i == j) {
+        s.row_diagonal[j] += s.value[e];
+        continue;
+      }
+      const std::size_t a = static_cast<std::size_t>(j) * w + count[j]++, b = static_cast<std::size_t>(i) * w + count[i]++;
+      s.row_column[a] = i;
+      s.row_value[a] = s.value[e];
+      s.row_column[b] = j;
+      s.row_value[b] = s.value[e];
+    }
 }
 
 void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc,

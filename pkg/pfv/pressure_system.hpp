@@ -26,6 +26,15 @@ struct PressureSystem {
   // Upper triangle of G over the unknowns, compressed by column (row <= column).
   std::vector<int> col_start, row;
   std::vector<double> value;
+  // The same G by rows in a fixed width (ELLPACK; index_rows() below), for the residual of
+  // every refinement pass: unknown u's off-diagonal entries in slots u * row_width .. (u + 1) *
+  // row_width - 1, padded with (u, 0). A pore cell has at most four neighbours, so the width
+  // is 4 on a tetrahedral mesh, and each residual entry is a gather of its row, where the
+  // upper triangle by column needs a scattered read-modify-write for the lower half.
+  // Optional: empty unless index_rows() was called.
+  int row_width = 0;
+  std::vector<int> row_column;
+  std::vector<double> row_value, row_diagonal;
 
   int n_unknowns() const { return static_cast<int>(unknown_cell.size()); }
 };
@@ -37,6 +46,10 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
                                         const BoundaryConditions& bc,
                                         const std::vector<int>& imposed_cells,
                                         const std::vector<double>& storage = {});
+
+// Fills row_width, row_column, row_value and row_diagonal from col_start, row and value
+// (assemble_pressure_system does it).
+void index_rows(PressureSystem& s);
 
 // Pressures of the Dirichlet cells from the current boundary values (cheap; every step).
 void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc,

@@ -17,9 +17,36 @@ double max_abs(const std::vector<double>& v) {
 
 }  // namespace
 
+namespace {
+
+// r = b - G x from the rows (PressureSystem::row_width etc.); W > 0 fixes the width at compile time.
+template <int W>
+void residual_by_rows(const PressureSystem& s, const std::vector<double>& b, const std::vector<double>& x,
+                      std::vector<double>& r) {
+  const int n = s.n_unknowns();
+  const int w = W > 0 ? W : s.row_width;
+  const int* column = s.row_column.data();
+  const double* value = s.row_value.data();
+  r.resize(n);
+  for (int u = 0; u < n; ++u, column += w, value += w) {
+    double gx = s.row_diagonal[u] * x[u];
+    for (int f = 0; f < w; ++f) gx += value[f] * x[column[f]];
+    r[u] = b[u] - gx;
+  }
+}
+
+}  // namespace
+
 void residual(const PressureSystem& s, const std::vector<double>& b, const std::vector<double>& x,
               std::vector<double>& r) {
   const int n = s.n_unknowns();
+  if (static_cast<int>(s.row_diagonal.size()) == n && n > 0) {
+    if (s.row_width == 4)
+      residual_by_rows<4>(s, b, x, r);
+    else
+      residual_by_rows<0>(s, b, x, r);
+    return;
+  }
   r.assign(b.begin(), b.end());
   for (int j = 0; j < n; ++j) {
     const double xj = x[j];

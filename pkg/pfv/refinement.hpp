@@ -50,7 +50,8 @@ class Refinement {
   int passes_ = 0;
 };
 
-// r = b - G x with G's upper triangle stored by column (PressureSystem::col_start/row/value).
+// r = b - G x: from G's rows (PressureSystem::row_width ..., filled by index_rows), else from
+// its upper triangle by column (col_start/row/value).
 void residual(const PressureSystem& system, const std::vector<double>& b, const std::vector<double>& x,
               std::vector<double>& r);
 

@@ -5,6 +5,7 @@
 
 #include "cholmod_solver.hpp"
 #include "pressure_system.hpp"
+#include "vec3.hpp"  // kMinParallelLoop
 
 namespace pfv {
 namespace {
@@ -25,10 +26,11 @@ void residual_by_rows(const PressureSystem& s, const std::vector<double>& b, con
                       std::vector<double>& r) {
   const int n = s.n_unknowns();
   const int w = W > 0 ? W : s.row_width;
-  const int* column = s.row_column.data();
-  const double* value = s.row_value.data();
   r.resize(n);
-  for (int u = 0; u < n; ++u, column += w, value += w) {
+#pragma omp parallel for schedule(static) if (n > kMinParallelLoop)
+  for (int u = 0; u < n; ++u) {
+    const int* column = s.row_column.data() + static_cast<std::size_t>(u) * w;
+    const double* value = s.row_value.data() + static_cast<std::size_t>(u) * w;
     double gx = s.row_diagonal[u] * x[u];
     for (int f = 0; f < w; ++f) gx += value[f] * x[column[f]];
     r[u] = b[u] - gx;

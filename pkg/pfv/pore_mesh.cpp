@@ -94,6 +94,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
     f.factorize(s, settings.force_metis ? Ordering::kMetis : settings.ordering,
                 settings.mixed_precision ? FactorPrecision::kScaled32 : FactorPrecision::kDouble, given,
                 settings.mixed_precision_min_entries);
+    if (f.reduced_precision()) index_rows(l.system);  // for the refinement's residual; a double factor never reads them
     if (f.ready() && f.permutation())
       l.ordering = std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
                                                         f.ordering_given() ? previous->fresh_fill() : f.fill(),

@@ -113,7 +113,6 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
     s.row[pos] = u;
     s.value[pos] = s.diagonal[c];
   }
-  index_rows(s);
   return s;
 }
 

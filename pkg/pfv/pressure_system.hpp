@@ -31,7 +31,7 @@ struct PressureSystem {
   // row_width - 1, padded with (u, 0). A pore cell has at most four neighbours, so the width
   // is 4 on a tetrahedral mesh, and each residual entry is a gather of its row, where the
   // upper triangle by column needs a scattered read-modify-write for the lower half.
-  // Optional: empty unless index_rows() was called.
+  // Empty unless index_rows() was called: only a refined solve needs them.
   int row_width = 0;
   std::vector<int> row_column;
   std::vector<double> row_value, row_diagonal;
@@ -48,7 +48,7 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
                                         const std::vector<double>& storage = {});
 
 // Fills row_width, row_column, row_value and row_diagonal from col_start, row and value
-// (assemble_pressure_system does it).
+// (build_linear_system does it for a 32-bit factor, whose refinement reads them).
 void index_rows(PressureSystem& s);
 
 // Pressures of the Dirichlet cells from the current boundary values (cheap; every step).

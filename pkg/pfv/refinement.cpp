@@ -16,10 +16,6 @@ double max_abs(const std::vector<double>& v) {
   return m;
 }
 
-}  // namespace
-
-namespace {
-
 // r = b - G x from the rows (PressureSystem::row_width etc.); W > 0 fixes the width at compile time.
 template <int W>
 void residual_by_rows(const PressureSystem& s, const std::vector<double>& b, const std::vector<double>& x,

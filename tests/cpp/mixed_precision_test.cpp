@@ -284,8 +284,13 @@ TEST(MixedPrecision, ResidualByRowsEqualsResidualByColumns) {
   // The refinement's residual reads G by rows (index_rows); the upper triangle by column is
   // the reference. Rows of width 4 (an assembled pore network) and of another width.
   const auto p = test::random_packing(400, 5, 0.02, 0.035);
-  FlowEngine e = test::permeameter(1);
+  FlowEngine e = test::permeameter(1), exact = test::permeameter(1);
+  e.settings.mixed_precision_min_entries = 0;  // a 32-bit factor: the engine indexes the rows
+  exact.settings.mixed_precision = false;      // a double factor: no refinement, no rows
   e.step(p.centre, p.radius, p.walls, 1.0);
+  exact.step(p.centre, p.radius, p.walls, 1.0);
+  ASSERT_TRUE(e.cholmod().reduced_precision());
+  EXPECT_TRUE(exact.system().row_diagonal.empty());
   PressureSystem chain = graded_chain(60, 2);
   index_rows(chain);
   for (const PressureSystem* s : {&e.system(), static_cast<const PressureSystem*>(&chain)}) {

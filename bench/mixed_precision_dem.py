@@ -41,7 +41,7 @@ def run(steps, mixed, tolerance=None):
         O.step()
         p = np.array(core.pressure())
         solve.append(core.step_times()['solve'])
-        passes.append(core.gs_iterations)
+        passes.append(core.refinement_passes)
         change.append(np.abs(p - previous).max() / np.abs(p).max())
         history.append(p)
         previous = p

@@ -108,7 +108,7 @@ def mixed_precision(pos, rad, walls):
             result[mixed] = pressures
             print('   %s, %s: solve %s (steps 4-30), passes at the last step %d, contraction %.2g'
                   % ('evicted ' if evict else 'in cache', 'mixed ' if mixed else 'double', stats(times[3:]),
-                     e.gs_iterations, e.refinement_contraction()))
+                     e.refinement_passes, e.refinement_contraction()))
         diff = max(np.abs(a - b).max() / np.abs(b).max() for a, b in zip(result[True], result[False]))
         print('   largest |p_mixed - p_double| / max|p| over the 30 steps: %.2g' % diff)
 

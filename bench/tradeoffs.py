@@ -134,6 +134,11 @@ def packing(n, work, seed=1, iters=300):
     return x, r
 
 
+def solver_iterations(e):
+    """What the last solve iterated: Gauss-Seidel sweeps, CG iterations or refinement passes."""
+    return e.sweeps + e.cg_iterations + e.refinement_passes
+
+
 def packing_stats(x, r):
     from scipy.spatial import cKDTree
     side = (len(r) / 1000) ** (1 / 3)
@@ -153,7 +158,7 @@ def make_engine(pfv, solver=3, tol=1e-6, interval=1, def_tol=0.0, background=Fal
     if ref_tol is not None:
         e.refinement_tolerance = ref_tol
     e.viscosity = VISCOSITY
-    e.use_solver = solver
+    e.solver = {0: 'gauss_seidel', 1: 'conjugate_gradient', 3: 'cholesky'}[solver]
     e.tolerance = tol
     e.mesh_update_interval = interval
     e.def_tolerance = def_tol
@@ -237,7 +242,7 @@ def run_perm(pfv, n, work, rounds, quick):
                     errs.append(dict(g_error=abs(q_in + q_out) / abs(q_in), q_error=abs(q_in - rq) / abs(rq),
                                      p_error=float(np.max(np.abs(pr - rp))) / p,
                                      f_error=float(np.linalg.norm(f - rf) / np.linalg.norm(rf)),
-                                     iters=e.gs_iterations))
+                                     iters=solver_iterations(e)))
             rec['first'].append(times[0])
             rec['step'].append(float(np.median(times[1:])))
             if rnd == 0:
@@ -300,7 +305,7 @@ def run_oedo(pfv, scene, n, work, quick):
                 remeshed[j, k] = e.remesh_pending()  # launched this step (adopted, uncounted, at the next)
             else:
                 remeshed[j, k] = e.remesh_count != before
-            iters[j, k] = e.gs_iterations
+            iters[j, k] = solver_iterations(e)
         for j, e in enumerate(engines):
             f = e.forces()
             base[j, k] = -f[n + 2, 1] / (side * side)

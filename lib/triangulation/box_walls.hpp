@@ -6,7 +6,7 @@
 #pragma once
 #include <array>
 
-#include "vec3.hpp"
+#include "triangulation/vec3.hpp"
 
 namespace pfv {
 

@@ -1,11 +1,12 @@
-#include "pore_geometry.hpp"
+#include "triangulation/pore_geometry.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "solid_angle.hpp"
+#include "pfv/common/parallel.hpp"
+#include "triangulation/solid_angle.hpp"
 
 namespace pfv {
 namespace {

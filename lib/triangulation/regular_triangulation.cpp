@@ -1,4 +1,4 @@
-#include "regular_triangulation.hpp"
+#include "triangulation/regular_triangulation.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Regular_triangulation_3.h>

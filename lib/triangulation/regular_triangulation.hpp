@@ -8,9 +8,9 @@
 #include <memory>
 #include <vector>
 
-#include "box_walls.hpp"
-#include "mesh.hpp"
-#include "vec3.hpp"
+#include "triangulation/box_walls.hpp"
+#include "triangulation/mesh.hpp"
+#include "triangulation/vec3.hpp"
 
 namespace pfv {
 

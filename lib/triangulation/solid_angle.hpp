@@ -3,7 +3,7 @@
 #pragma once
 #include <cmath>
 
-#include "vec3.hpp"
+#include "triangulation/vec3.hpp"
 
 namespace pfv {
 

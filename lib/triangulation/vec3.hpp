@@ -5,8 +5,4 @@
 
 namespace pfv {
 using Vec3 = Eigen::Vector3d;
-
-// Loops shorter than this run on one thread: waking a thread team costs more than the loop,
-// and far more when the cores are shared with other processes.
-constexpr int kMinParallelLoop = 20000;
 }  // namespace pfv

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "cholmod_solver.hpp"
-#include "flow_engine.hpp"
+#include "pfv/linalg/cholmod_solver.hpp"
+#include "pfv/engine/flow_engine.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "flow_engine.hpp"
+#include "pfv/engine/flow_engine.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;

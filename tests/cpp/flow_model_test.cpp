@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "conductance.hpp"
-#include "flow_engine.hpp"
+#include "pfv/model/conductance.hpp"
+#include "pfv/engine/flow_engine.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;
@@ -49,11 +49,11 @@ TEST(FlowModel, CholmodMatchesDenseSolve) {
 TEST(FlowModel, GaussSeidelConvergesToTheDirectSolution) {
   const auto p = test::random_packing(200, 22);
   FlowEngine direct = permeameter(0), gs = permeameter(0);
-  gs.settings.use_solver = 0;
+  gs.settings.solver = SolverKind::kGaussSeidel;
   gs.settings.tolerance = 1e-10;
   direct.step(p.centre, p.radius, p.walls, 1.0);
   gs.step(p.centre, p.radius, p.walls, 1.0);
-  EXPECT_GT(gs.gs_iterations(), 1);
+  EXPECT_GT(gs.last_solve().sweeps, 1);
   for (std::size_t c = 0; c < direct.pressure().size(); ++c) EXPECT_NEAR(gs.pressure()[c], direct.pressure()[c], 1e-7);
 }
 
@@ -265,17 +265,17 @@ TEST(FlowEngine, FailedBackgroundRemeshSurfacesAndRecovers) {
 TEST(FlowModel, PreconditionedCgMatchesDirectAndWarmStartPays) {
   auto p = test::random_packing(300, 33);
   FlowEngine direct = permeameter(1), cg = permeameter(1);
-  cg.settings.use_solver = 1;
+  cg.settings.solver = SolverKind::kConjugateGradient;
   cg.settings.tolerance = 1e-12;
   direct.step(p.centre, p.radius, p.walls, 1e-3);
   cg.step(p.centre, p.radius, p.walls, 1e-3);
   for (std::size_t c = 0; c < direct.pressure().size(); ++c) EXPECT_NEAR(cg.pressure()[c], direct.pressure()[c], 1e-9);
-  const int cold = cg.gs_iterations();
+  const int cold = cg.last_solve().cg_iterations;
   // A small deformation: the warm start from the previous pressures needs fewer iterations.
   for (auto& x : p.centre) x = Vec3(0.5, 0.5, 0.5) + 0.99999 * (x - Vec3(0.5, 0.5, 0.5));
   direct.step(p.centre, p.radius, p.walls, 1e-3);
   cg.step(p.centre, p.radius, p.walls, 1e-3);
-  EXPECT_LT(cg.gs_iterations(), cold);
+  EXPECT_LT(cg.last_solve().cg_iterations, cold);
   for (std::size_t c = 0; c < direct.pressure().size(); ++c)
     EXPECT_NEAR(cg.pressure()[c], direct.pressure()[c], 1e-9 * (1 + std::abs(direct.pressure()[c])));
 }

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <unistd.h>
 
-#include "flow_engine.hpp"
+#include "pfv/engine/flow_engine.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "flow_engine.hpp"
+#include "pfv/engine/flow_engine.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;

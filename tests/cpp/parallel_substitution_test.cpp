@@ -8,8 +8,8 @@
 #include <omp.h>
 #endif
 
-#include "flow_engine.hpp"
-#include "refinement.hpp"
+#include "pfv/engine/flow_engine.hpp"
+#include "pfv/linalg/refinement.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;

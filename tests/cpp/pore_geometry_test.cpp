@@ -1,12 +1,12 @@
 // Geometry on hand-computable configurations and global identities of the pore partition.
-#include "pore_geometry.hpp"
+#include "triangulation/pore_geometry.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numeric>
 
-#include "regular_triangulation.hpp"
+#include "triangulation/regular_triangulation.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;

@@ -7,8 +7,8 @@
 #include <omp.h>
 #endif
 
-#include "flow_engine.hpp"
-#include "serial_openmp.hpp"
+#include "pfv/engine/flow_engine.hpp"
+#include "pfv/linalg/serial_openmp.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;

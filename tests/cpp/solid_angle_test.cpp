@@ -1,4 +1,4 @@
-#include "solid_angle.hpp"
+#include "triangulation/solid_angle.hpp"
 
 #include <gtest/gtest.h>
 

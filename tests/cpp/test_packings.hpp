@@ -3,9 +3,9 @@
 #include <random>
 #include <vector>
 
-#include "box_walls.hpp"
-#include "flow_engine.hpp"
-#include "vec3.hpp"
+#include "triangulation/box_walls.hpp"
+#include "pfv/engine/flow_engine.hpp"
+#include "triangulation/vec3.hpp"
 
 namespace pfv::test {
 

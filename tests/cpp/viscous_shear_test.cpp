@@ -5,10 +5,10 @@
 #include <cmath>
 #include <random>
 
-#include "flow_engine.hpp"
-#include "force_cache.hpp"
+#include "pfv/engine/flow_engine.hpp"
+#include "pfv/model/force_cache.hpp"
 #include "test_packings.hpp"
-#include "viscous_shear.hpp"
+#include "pfv/model/viscous_shear.hpp"
 
 using namespace pfv;
 using test::permeameter;

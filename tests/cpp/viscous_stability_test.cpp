@@ -6,7 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
-#include "flow_engine.hpp"
+#include "pfv/engine/flow_engine.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;

@@ -81,7 +81,6 @@ _SUPPORTED = {
     "minKdivKmean": "min_k_div_k_mean",
     "maxKdivKmean": "max_k_div_k_mean",
     "slipBoundary": "slip_boundary",
-    "useSolver": "use_solver",
     "tolerance": "tolerance",
     "relax": "relax",
     "forceMetis": "force_metis",
@@ -96,6 +95,10 @@ _SUPPORTED = {
     "mixed_precision_min_entries": "mixed_precision_min_entries",
     "refinement_tolerance": "refinement_tolerance",
 }
+
+
+_SOLVER_OF_USE_SOLVER = {0: "gauss_seidel", 1: "conjugate_gradient", 3: "cholesky"}
+_USE_SOLVER_OF = {v: k for k, v in _SOLVER_OF_USE_SOLVER.items()}
 
 
 class FlowEngine(PyRunner):
@@ -138,7 +141,6 @@ class FlowEngine(PyRunner):
         self.command = f"__import__('pfv.flow_engine').flow_engine._run({self._key})"
         self.iterPeriod = 1
         self.initRun = True
-        self._core.use_solver = 3
         for name, value in kwargs.items():
             setattr(self, name, value)
 
@@ -203,6 +205,17 @@ class FlowEngine(PyRunner):
             object.__setattr__(self, "_wall_ids", value)
             object.__setattr__(self, "_ids", None)
             self._core.reset_history()
+
+    @property
+    def useSolver(self):
+        """YADE's solver number: 0 Gauss-Seidel, 1 conjugate gradients (PFV), 3 CHOLMOD."""
+        return _USE_SOLVER_OF[self._core.solver]
+
+    @useSolver.setter
+    def useSolver(self, value):
+        if value not in _SOLVER_OF_USE_SOLVER:
+            raise ValueError("useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG, PFV) or 3 (CHOLMOD)")
+        self._core.solver = _SOLVER_OF_USE_SOLVER[value]
 
     @property
     def updateTriangulation(self):
@@ -398,9 +411,8 @@ class FlowEngine(PyRunner):
                 warnings.warn(f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
                               f"regular triangulation and get no fluid force (ids {self._ids[hidden][:10].tolist()}...)",
                               stacklevel=2)
-        # The engine itself: its force array read in C++, no numpy copy (a wrapper of the core,
-        # as a benchmark's timer, hands over its forces() instead).
-        self._force_bridge[1].apply(O.forces.addF, core if type(core) is Engine else core.forces())
+        # The engine's force array is read in C++, without a numpy copy.
+        self._force_bridge[1].apply(O.forces.addF, core)
 
     @property
     def viscous_time_step(self):
@@ -483,7 +495,7 @@ class FlowEngine(PyRunner):
     # -- boundary conditions --------------------------------------------------------------
     def updateBCs(self):
         """Apply changed boundary values and types (PFV applies values at every step anyway)."""
-        self._core.request_bc_update()
+        self._core.request_system_rebuild()
 
     def imposePressure(self, pos, p):
         return self._core.impose_pressure(tuple(pos), float(p))

@@ -1,0 +1,62 @@
+// User settings of the flow engine. A C++ caller changes them directly; the next step compares
+// them with what the current mesh and linear system were built from and rebuilds what is
+// stale (pore_mesh.hpp, linear_system.hpp), so that every caller gets the same rebuilds.
+#pragma once
+#include "pfv/linalg/cholmod_solver.hpp"
+#include "pfv/linalg/pressure_solver.hpp"
+#include "pfv/model/conductance.hpp"
+
+namespace pfv {
+
+struct EngineSettings {
+  ConductanceModel conductance;
+  bool slip_boundary = true;
+  SolverKind solver = SolverKind::kCholesky;
+  double tolerance = 1e-6;  // iterative solvers
+  double relax = 1.9;       // Gauss-Seidel
+  int max_iterations = 200000;
+  bool force_metis = false;  // YADE's forceMetis: METIS ordering whatever 'ordering' says
+  Ordering ordering = Ordering::kAuto;
+  // Carry the elimination order over to the next remesh (ordering_reuse.hpp) while its factor
+  // has at most max_fill_growth times the entries per unknown of the last fresh ordering.
+  bool reuse_ordering = true;
+  double max_fill_growth = 1.1;
+  // Cholesky only: keep the factor as 32-bit integers scaled per column
+  // (FactorPrecision::kScaled32) and refine each solve in double from the previous (extrapolated)
+  // pressures (refinement.hpp) until the estimated error is below refinement_tolerance *
+  // (max p - min p) over the unknowns. Falls back to the double factor if G is too
+  // ill-conditioned for it. Only for factors of at least mixed_precision_min_entries stored
+  // entries: a smaller double factor is served from the caches, and the residual of each pass
+  // costs what the 32-bit factor saves (doc/solvers.md).
+  bool mixed_precision = true;
+  double mixed_precision_min_entries = 2e6;
+  double refinement_tolerance = 1e-10;
+  int max_refinement_passes = 8;
+  // Let CHOLMOD fork the OpenMP teams of its numeric factorisation (compiled in) instead of
+  // running them on the calling thread (serial_openmp.hpp); kept to measure the difference.
+  bool cholmod_openmp_teams = false;
+  int mesh_update_interval = 1000;
+  double def_tolerance = 0;  // YADE's default: no strain-triggered remesh
+  double p_zero = 0;
+  // Fluid bulk modulus K (YADE's fluidBulkModulus); 0 = incompressible. When positive each
+  // cell stores fluid: (V_f / K) dp/dt enters continuity (implicit Euler), which adds
+  // V_f / (K dt) to the diagonal of G; the system is then rebuilt when dt changes.
+  double fluid_bulk_modulus = 0;
+  // Remesh on a second thread from a snapshot while steps go on with the old mesh (YADE's
+  // `multithread`): the new mesh arrives a few steps late.
+  bool background_remesh = false;
+  // Viscous shear between neighbouring spheres (YADE's viscousShear; viscous_shear.hpp). Off:
+  // no pair geometry is built or stored and the step does no extra work.
+  bool viscous_shear = false;
+
+  SolveControl solve_control() const {
+    return {tolerance, relax, max_iterations, refinement_tolerance, max_refinement_passes};
+  }
+  // The ordering CHOLMOD is asked for.
+  Ordering factor_ordering() const { return force_metis ? Ordering::kMetis : ordering; }
+};
+
+// Throws std::invalid_argument naming the first setting out of its range.
+void validate(const EngineSettings& settings);
+
+}  // namespace pfv

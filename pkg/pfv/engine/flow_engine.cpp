@@ -1,0 +1,338 @@
+#include "pfv/engine/flow_engine.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "pfv/common/parallel.hpp"
+#include "pfv/common/stage_timer.hpp"
+#include "pfv/linalg/cholesky_solver.hpp"
+#include "pfv/snapshot/snapshot.hpp"
+
+namespace pfv {
+
+FlowEngine::~FlowEngine() {
+  if (pending_) pending_->result.wait();  // the worker reads copies only, but let it finish
+}
+
+bool FlowEngine::remesh_due() const {
+  return remesh_requested_ || !has_mesh() ||
+         (settings.mesh_update_interval > 0 && steps_since_remesh_ >= settings.mesh_update_interval) ||
+         (settings.def_tolerance > 0 && strain_ >= settings.def_tolerance) || mesh_->recipe.stale_for(settings);
+}
+
+bool FlowEngine::metis_used() const {
+  const CholeskySolver* c = linear_.cholesky();
+  return c && c->factor().metis_used();
+}
+
+const CholmodSolver& FlowEngine::cholmod() const {
+  const CholeskySolver* c = linear_.cholesky();
+  if (!c) throw std::logic_error("the engine has no Cholesky factor (another solver, or no system yet)");
+  return c->factor();
+}
+
+double FlowEngine::refinement_contraction() const {
+  const CholeskySolver* c = linear_.cholesky();
+  return c ? c->refinement_contraction() : -1.0;
+}
+
+void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                      double dt) {
+  const auto start = StageClock::now();
+  validate_step(centres, radii, walls, dt);
+  schedule_remesh(centres, radii, walls, dt);
+  rebuild_stale_system(dt);
+  // From here on everything writes into scratch buffers; the engine's state changes only in
+  // commit(), once the step has produced finite pressures and forces.
+  const double strain = assemble(centres, walls, dt);
+  solve();
+  compute_forces(centres, dt);
+  commit(centres, walls, strain);
+  step_times_.total = seconds_since(start);
+}
+
+void FlowEngine::validate_step(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                               const BoxWalls& walls, double dt) const {
+  if (!(dt > 0 && std::isfinite(dt))) throw std::invalid_argument("time step must be positive and finite");
+  validate(settings);
+  validate_snapshot(centres, radii, walls);
+}
+
+void FlowEngine::schedule_remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                                 const BoxWalls& walls, double dt) {
+  // Settings the mesh depends on changed: the old mesh is wrong, remesh now.
+  if (has_mesh() && mesh_->recipe.stale_for(settings)) remesh_requested_ = true;
+  const bool same_spheres = has_mesh() && centres.size() == static_cast<std::size_t>(mesh().n_spheres);
+  if (pending_ && (!same_spheres || remesh_requested_)) {
+    pending_->result.wait();  // superseded: its snapshot is out of date
+    pending_.reset();
+  }
+  adopt_finished_remesh();
+  if (!same_spheres || remesh_requested_ || (remesh_due() && !pending_)) {
+    if (settings.background_remesh && same_spheres && !remesh_requested_)
+      remesh_in_background(centres, radii, walls, dt);
+    else
+      remesh_now(centres, radii, walls, dt);
+  }
+}
+
+void FlowEngine::adopt_finished_remesh() {
+  if (!pending_ || pending_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  auto future = std::move(pending_->result);
+  pending_.reset();
+  std::optional<Remesh> r;
+  try {
+    r.emplace(future.get());
+  } catch (...) {
+    remesh_requested_ = true;  // the next step remeshes in the foreground and says why
+    throw;
+  }
+  adopt(std::move(r->first), std::move(r->second));
+}
+
+void FlowEngine::remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                                      const BoxWalls& walls, double dt) {
+  // Snapshot now, build on another thread, carry on with the current mesh meanwhile.
+  pending_ = Pending{std::async(std::launch::async, [c = centres, r = radii, w = walls, s = settings, b = bc, dt,
+                                                     o = linear_.ordering]() {
+    PoreMesh m = build_pore_mesh(c, r, w, s);
+    LinearSystem l = build_linear_system(m, b, s, dt, o.get());
+    return Remesh(std::move(m), std::move(l));
+  })};
+  strain_ = 0;
+  steps_since_remesh_ = 0;
+}
+
+void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                            const BoxWalls& walls, double dt) {
+  PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
+  // Free the old factor first (the largest object: peak memory is then one factor, not two).
+  // Should the new system fail, the old mesh is kept without a solver and the next step starts
+  // the remesh over; the last results stay readable meanwhile.
+  remesh_requested_ = true;
+  const auto ordering = linear_.ordering;  // survives the release of the old factor
+  LinearSystem l = build_linear_system(m, bc, settings, dt, ordering.get(), released_solver());
+  adopt(std::move(m), std::move(l));
+  strain_ = 0;
+  steps_since_remesh_ = 0;
+  remesh_requested_ = false;
+}
+
+std::unique_ptr<PressureSolver> FlowEngine::released_solver() {
+  auto solver = std::move(linear_.solver);
+  if (solver) solver->release();
+  return solver;
+}
+
+void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear) {
+  // The old pressure at the new pore centres: the state of a compressible fluid, and the warm
+  // start of the iterative solvers. (The direct solve of an incompressible fluid needs neither.)
+  std::vector<double> pressure(mesh.mesh().n_cells(), settings.p_zero);
+  if ((settings.solver != SolverKind::kCholesky || settings.fluid_bulk_modulus > 0) && has_mesh())
+    for (int c = 0; c < mesh.mesh().n_cells(); ++c) {
+      const int old = mesh_->tri.locate(mesh.cells.power_centre[c]);
+      if (old >= 0) pressure[c] = pressure_[old];
+    }
+  // A solver built elsewhere (a background remesh) learns what the current one has.
+  CholeskySolver* next = linear.cholesky();
+  const CholeskySolver* current = linear_.cholesky();
+  if (next && current && next != current) next->carry_over(*current);
+  StageTimes t = mesh.times;
+  t.assembly = linear.times.assembly;
+  t.analysis = linear.times.analysis;
+  t.factorization = linear.times.factorization;
+  remesh_times_ = t;
+  mesh_ = std::make_unique<PoreMesh>(std::move(mesh));
+  linear_ = std::move(linear);
+  pressure_ = std::move(pressure);
+  pressure_before_.clear();  // other cells
+  const int nc = mesh_->mesh().n_cells();
+  volume_.assign(mesh_->cells.volume.begin(), mesh_->cells.volume.end());
+  volume_rate_.assign(nc, 0.0);
+  // Previous volumes on the new cells, so that dV/dt stays an exact backward difference.
+  if (has_prev_ && centres_prev_.size() == static_cast<std::size_t>(mesh_->mesh().n_spheres))
+    for (int c = 0; c < nc; ++c) volume_[c] = cell_volume(mesh_->cells.shape[c], centres_prev_, walls_prev_);
+  else
+    has_prev_ = false;  // bodies appeared or vanished: no backward difference this step
+  ++remesh_count_;
+}
+
+void FlowEngine::rebuild_stale_system(double dt) {
+  if (linear_.ready() && !system_rebuild_requested_ && !linear_.recipe.stale_for(settings, bc, dt)) return;
+  const auto ordering = linear_.ordering;
+  linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver());
+  system_rebuild_requested_ = false;
+}
+
+double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& walls, double dt) {
+  const auto t0 = StageClock::now();
+  const int nc = mesh().n_cells();
+  // Pore strain of the step, max over cells (thesis 5.13). A near-flat cell would make any
+  // motion look like a huge strain, so volumes below the mean count as the mean.
+  double max_change = 0;
+  next_volume_.resize(nc);
+  volume_rate_.resize(nc);
+#pragma omp parallel for schedule(static) reduction(max : max_change) if (nc > kMinParallelLoop)
+  for (int c = 0; c < nc; ++c) {
+    const double v = cell_volume(mesh_->cells.shape[c], centres, walls);
+    const double dv = has_prev_ ? v - volume_[c] : 0.0;
+    volume_rate_[c] = dv / dt;
+    max_change = std::max(max_change, std::abs(dv) / std::max(v, mesh_->mean_cell_volume));
+    next_volume_[c] = v;
+  }
+  step_times_.volumes = seconds_since(t0);
+
+  // b = -dV/dt (+ V_f/(K dt) p^n, implicit Euler on the stored fluid) + imposed fluxes + the
+  // couplings to the Dirichlet cells, whose pressures are this step's boundary values.
+  next_pressure_ = pressure_;  // the iterative solvers' start
+  const PressureSystem& system = linear_.system;
+  apply_dirichlet_values(system, bc, next_pressure_);
+  const int nu = system.n_unknowns();
+  rhs_.resize(nu);
+  for (int u = 0; u < nu; ++u) rhs_[u] = -volume_rate_[system.unknown_cell[u]];
+  if (!linear_.storage.empty())
+    for (int u = 0; u < nu; ++u) rhs_[u] += linear_.storage[system.unknown_cell[u]] * pressure_[system.unknown_cell[u]];
+  for (std::size_t i = 0; i < linear_.imposed_flux_cells.size(); ++i) {
+    const int c = linear_.imposed_flux_cells[i];
+    if (c >= 0 && system.unknown[c] >= 0) rhs_[system.unknown[c]] += bc.imposed_flux[i].value;
+  }
+  for (std::size_t i = 0; i < linear_.coupling_k.size(); ++i)
+    rhs_[linear_.coupling_unknown[i]] += linear_.coupling_k[i] * next_pressure_[linear_.coupling_cell[i]];
+  return max_change;
+}
+
+void FlowEngine::solve() {
+  const auto t0 = StageClock::now();
+  const PressureSystem& system = linear_.system;
+  const int nu = system.n_unknowns();
+  last_solve_ = SolveStats{};
+  keep_trend_ = false;
+  if (nu > 0) {  // else every cell has an imposed pressure: nothing to solve
+    PressureSolver& solver = *linear_.solver;
+    // With a 32-bit factor, start from the pressures extrapolated from the last two steps: in a
+    // smooth motion that halves the first correction, and with it the error bound that decides
+    // whether a second pass is needed (the bound, not the guess, guarantees the accuracy).
+    const bool trend = solver.wants_extrapolated_start() && pressure_before_.size() == next_pressure_.size();
+    solution_.resize(nu);
+    for (int u = 0; u < nu; ++u) {
+      const int c = system.unknown_cell[u];
+      solution_[u] = trend ? 2 * next_pressure_[c] - pressure_before_[c] : next_pressure_[c];
+    }
+    last_solve_ = solver.solve(system, rhs_, solution_, settings.solve_control());
+    keep_trend_ = solver.wants_extrapolated_start();  // false once promoted to a double factor
+    for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
+  }
+  step_times_.solve = seconds_since(t0);
+}
+
+void FlowEngine::compute_forces(const std::vector<Vec3>& centres, double dt) {
+  auto t0 = StageClock::now();
+  mesh_->cache.apply(next_pressure_, next_force_);
+  step_times_.forces = seconds_since(t0);
+
+  if (!settings.viscous_shear && mesh_->shear) {  // switched off (or adopted from before)
+    mesh_->shear.reset();
+    mesh_->recipe.viscous_shear = false;
+  }
+  if (mesh_->shear) {
+    t0 = StageClock::now();
+    if (has_prev_ && centres_prev_.size() == centres.size())
+      mesh_->shear->add_forces(centres, centres_prev_, dt, settings.conductance.viscosity, next_force_, next_shear_);
+    else
+      next_shear_.assign(next_force_.size(), Vec3::Zero());  // no velocities yet
+    step_times_.shear_forces = seconds_since(t0);
+  } else if (!shear_force_.empty() || !next_shear_.empty()) {
+    std::vector<Vec3>().swap(shear_force_);
+    std::vector<Vec3>().swap(next_shear_);
+    step_times_.shear_forces = 0;
+  }
+}
+
+void FlowEngine::commit(const std::vector<Vec3>& centres, const BoxWalls& walls, double strain) {
+  // Never hand NaN or infinite forces back to the DEM.
+  const auto bad_p =
+      std::find_if(next_pressure_.begin(), next_pressure_.end(), [](double x) { return !std::isfinite(x); });
+  if (bad_p != next_pressure_.end())
+    throw std::domain_error("non-finite pore pressure in cell " + std::to_string(bad_p - next_pressure_.begin()) +
+                            " (check boundary values, imposed fluxes and the time step)");
+  for (std::size_t v = 0; v < next_force_.size(); ++v)
+    if (!next_force_[v].allFinite()) throw std::domain_error("non-finite fluid force on vertex " + std::to_string(v));
+
+  std::swap(volume_, next_volume_);
+  if (keep_trend_)
+    std::swap(pressure_before_, pressure_);  // kept for the next start; its buffer becomes scratch
+  else if (!pressure_before_.empty())
+    std::vector<double>().swap(pressure_before_);
+  std::swap(pressure_, next_pressure_);
+  std::swap(force_, next_force_);
+  std::swap(shear_force_, next_shear_);
+  strain_ += strain;
+  ++steps_since_remesh_;
+  centres_prev_ = centres;
+  walls_prev_ = walls;
+  has_prev_ = true;
+}
+double FlowEngine::boundary_flux(int wall) const {
+  // Fluid leaving through the wall: what flows into its Dirichlet cells from the rest of the
+  // pore space, plus what those cells expel themselves as they shrink (a moving drained wall
+  // sweeps their volume). Without deformation only the first term remains.
+  const PressureSystem& s = linear_.system;
+  double q = 0;
+  for (std::size_t c = 0; c < s.source.size(); ++c) {
+    if (s.source[c] != wall) continue;
+    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e) q += s.adj_k[e] * (pressure_[s.adj_cell[e]] - pressure_[c]);
+    if (c < volume_rate_.size()) q -= volume_rate_[c];
+  }
+  return q;
+}
+
+double FlowEngine::imposed_flux_total() const {
+  double q = 0;
+  const auto& cells = linear_.imposed_flux_cells;
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    if (cells[i] >= 0 && linear_.system.unknown[cells[i]] >= 0) q += bc.imposed_flux[i].value;
+  return q;
+}
+
+double FlowEngine::volume_rate_total() const {
+  double s = 0;
+  for (double r : volume_rate_) s += r;
+  return s;
+}
+
+double FlowEngine::average_pressure() const {
+  double pv = 0, v = 0;
+  for (std::size_t c = 0; c < pressure_.size(); ++c) {
+    pv += pressure_[c] * mesh_->cells.volume[c];
+    v += mesh_->cells.volume[c];
+  }
+  return v > 0 ? pv / v : 0.0;
+}
+
+double FlowEngine::average_slice_pressure(int axis, double position) const {
+  // Area average over the slice, sampled on a regular grid of the wall-bounded section.
+  if (axis < 0 || axis > 2) throw std::invalid_argument("axis must be 0, 1 or 2");
+  constexpr int kSamples = 40;
+  const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+  double sum = 0;
+  int count = 0;
+  for (int i = 0; i < kSamples; ++i)
+    for (int j = 0; j < kSamples; ++j) {
+      Vec3 x;
+      x[axis] = position;
+      x[a1] = walls_prev_.coord[2 * a1] + (i + 0.5) / kSamples * walls_prev_.extent(a1);
+      x[a2] = walls_prev_.coord[2 * a2] + (j + 0.5) / kSamples * walls_prev_.extent(a2);
+      const int c = locate(x);
+      if (c < 0) continue;
+      sum += pressure_[c];
+      ++count;
+    }
+  if (count == 0) throw std::invalid_argument("the slice lies outside the pore mesh");
+  return sum / count;
+}
+
+}  // namespace pfv

@@ -1,0 +1,152 @@
+// The coupled flow engine: one call per DEM step runs the pipeline
+//   scene snapshot -> (remesh: pore mesh, linear system) -> dV/dt -> solve -> forces.
+// It knows nothing of YADE; pkg/pfv/python adapts it to YADE's FlowEngine interface.
+#pragma once
+#include <future>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "pfv/engine/engine_settings.hpp"
+#include "pfv/engine/linear_system.hpp"
+#include "pfv/engine/pore_mesh.hpp"
+#include "pfv/engine/stage_times.hpp"
+#include "pfv/model/boundary_conditions.hpp"
+
+namespace pfv {
+
+class FlowEngine {
+ public:
+  // Changed freely between steps; the next step rebuilds whatever they make stale.
+  EngineSettings settings;
+  BoundaryConditions bc;
+
+  FlowEngine() = default;
+  FlowEngine(FlowEngine&&) = default;
+  FlowEngine& operator=(FlowEngine&&) = default;
+  ~FlowEngine();
+
+  // One coupled step at positions X(t); dt is the DEM step that led here.
+  // Throws std::invalid_argument on bad positions or settings, std::domain_error on a singular
+  // system or non-finite results; the engine is unchanged by a step that throws.
+  void step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
+
+  // The next step remeshes (in the foreground).
+  void request_remesh() { remesh_requested_ = true; }
+  // The next step rebuilds the linear system (YADE's updateBCs; changes of the boundary types,
+  // imposed points and solver settings are noticed without it).
+  void request_system_rebuild() { system_rebuild_requested_ = true; }
+  // Forget the previous positions: the next step has no dV/dt term. For when the boundary
+  // is redefined (a moved fictitious wall is not a change of pore volume).
+  void reset_history() { has_prev_ = false; }
+  bool remesh_due() const;
+  bool remesh_pending() const { return pending_.has_value(); }
+  // Blocks until a background remesh in flight has finished; the next step adopts it.
+  void wait_for_remesh() const {
+    if (pending_) pending_->result.wait();
+  }
+  bool has_mesh() const { return mesh_ != nullptr; }
+
+  // Stability limit of the explicit coupling from the fluid alone: 2 / lambda_max of
+  // M^-1 V, where V maps sphere velocities to fluid forces through the current mesh
+  // (dV/dt -> solve -> forces, plus the viscous shear term when on), linearised about the
+  // last step's positions; masses <= 0 mark spheres that do not move. Collective modes
+  // (groups of spheres squeezing shared pores) make this smaller than the thesis'
+  // single-particle dt_MV. Needs a mesh (viscous_stability.cpp).
+  // Without a mode: Arnoldi from a fixed start, at most 'iterations' operator applications,
+  // stopping once the largest Ritz value changes by less than 1e-6. mode: if given with one
+  // entry per sphere (not all zero), power iteration starts from it instead (warm start from
+  // the previous mesh's mode, stopping once the estimate changes by less than 0.5 %). On
+  // return mode holds the estimated eigenvector (unit norm), and applications (if given) the
+  // number of operator applications made. Throws std::domain_error if the operator gives a
+  // non-finite estimate.
+  double viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode = nullptr,
+                                 int* applications = nullptr) const;
+  // accel = M^-1 F(v): the fluid forces of the sphere velocities v on the current mesh over
+  // the masses (zero for mass <= 0). The operator of viscous_stability_limit; public for tests.
+  void apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,
+                              std::vector<Vec3>& accel) const;
+
+  // Results of the last step.
+  const std::vector<Vec3>& forces() const { return force_; }  // spheres, then six walls
+  // The viscous shear part of forces() (empty while viscous_shear is off; zero on a step
+  // without previous positions, whose velocities are unknown).
+  const std::vector<Vec3>& shear_forces() const { return shear_force_; }
+  // The pairs of the current mesh, or nullptr while viscous_shear is off.
+  const ViscousShear* viscous_shear() const { return mesh_ && mesh_->shear ? &*mesh_->shear : nullptr; }
+  const std::vector<double>& pressure() const { return pressure_; }
+  const Mesh& mesh() const { return mesh_->mesh(); }
+  const CellGeometry& cells() const { return mesh_->cells; }
+  const FacetGeometry& facets() const { return mesh_->facets; }
+  const std::vector<double>& conductances() const { return mesh_->k; }
+  const PressureSystem& system() const { return linear_.system; }
+  const BoxWalls& walls() const { return walls_prev_; }
+  double boundary_flux(int wall) const;
+  double imposed_flux_total() const;
+  double volume_rate_total() const;  // sum of dV/dt over all cells
+  double average_pressure() const;
+  double average_slice_pressure(int axis, double position) const;
+  int locate(const Vec3& x) const { return mesh_ ? mesh_->tri.locate(x) : -1; }
+  bool metis_used() const;
+  // The Cholesky factor of the current system; throws std::logic_error with another solver.
+  const CholmodSolver& cholmod() const;
+  // The current system's Cholesky solver, or nullptr (another solver, or no system yet).
+  const CholeskySolver* cholesky() const { return linear_.cholesky(); }
+  int remesh_count() const { return remesh_count_; }
+  double accumulated_strain() const { return strain_; }
+  const SolveStats& last_solve() const { return last_solve_; }
+  double refinement_contraction() const;  // -1 until measured, or without a 32-bit factor
+  const StageTimes& remesh_times() const { return remesh_times_; }
+  const StageTimes& step_times() const { return step_times_; }
+
+ private:
+  using Remesh = std::pair<PoreMesh, LinearSystem>;
+  struct Pending {
+    std::future<Remesh> result;
+  };
+
+  // The stages of step(), in order.
+  void validate_step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                     double dt) const;
+  void schedule_remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                       double dt);
+  void rebuild_stale_system(double dt);
+  double assemble(const std::vector<Vec3>& centres, const BoxWalls& walls, double dt);  // returns the pore strain
+  void solve();
+  void compute_forces(const std::vector<Vec3>& centres, double dt);
+  void commit(const std::vector<Vec3>& centres, const BoxWalls& walls, double strain);
+
+  void adopt_finished_remesh();
+  void remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                            const BoxWalls& walls, double dt);
+  void remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                  double dt);
+  void adopt(PoreMesh&& mesh, LinearSystem&& linear);
+  // The current system's solver with its factor freed, handed over to the next build (the
+  // storage of the factor's values is reused): peak memory one factor, no new pages to fault.
+  std::unique_ptr<PressureSolver> released_solver();
+
+  std::unique_ptr<PoreMesh> mesh_;
+  LinearSystem linear_;
+  std::optional<Pending> pending_;
+
+  std::vector<double> pressure_, volume_, volume_rate_, rhs_, solution_;
+  std::vector<Vec3> force_;
+  std::vector<double> next_volume_, next_pressure_;  // scratch of the step being computed
+  std::vector<double> pressure_before_;  // the step before pressure_'s, on this mesh (extrapolated start)
+  bool keep_trend_ = false;              // the solver of this step wants the extrapolated start next
+  std::vector<Vec3> next_force_;
+  std::vector<Vec3> shear_force_, next_shear_;  // only with viscous_shear
+  std::vector<Vec3> centres_prev_;
+  BoxWalls walls_prev_;
+  bool has_prev_ = false;
+  double strain_ = 0;
+  int steps_since_remesh_ = 0;
+  int remesh_count_ = 0;
+  SolveStats last_solve_;
+  bool remesh_requested_ = true;
+  bool system_rebuild_requested_ = false;
+  StageTimes remesh_times_, step_times_;
+};
+
+}  // namespace pfv

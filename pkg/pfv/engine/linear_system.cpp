@@ -1,0 +1,120 @@
+#include "pfv/engine/linear_system.hpp"
+
+#include "pfv/common/stage_timer.hpp"
+#include "pfv/linalg/cholesky_solver.hpp"
+#include "pfv/linalg/gauss_seidel_solver.hpp"
+#include "pfv/linalg/pcg_solver.hpp"
+
+namespace pfv {
+namespace {
+
+std::vector<Vec3> positions(const std::vector<PointCondition>& conditions) {
+  std::vector<Vec3> x;
+  x.reserve(conditions.size());
+  for (const auto& c : conditions) x.push_back(c.position);
+  return x;
+}
+
+std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::kGaussSeidel:
+      return std::make_unique<GaussSeidelSolver>();
+    case SolverKind::kConjugateGradient:
+      return std::make_unique<PcgSolver>();
+    case SolverKind::kCholesky:
+      break;
+  }
+  return std::make_unique<CholeskySolver>();
+}
+
+}  // namespace
+
+SystemRecipe::SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc, double step)
+    : solver(s.solver),
+      ordering(s.factor_ordering()),
+      mixed_precision(s.mixed_precision),
+      mixed_precision_min_entries(s.mixed_precision_min_entries),
+      fluid_bulk_modulus(s.fluid_bulk_modulus),
+      dt(step),
+      is_pressure(bc.is_pressure),
+      imposed_pressure_at(positions(bc.imposed_pressure)),
+      imposed_flux_at(positions(bc.imposed_flux)) {}
+
+bool SystemRecipe::stale_for(const EngineSettings& s, const BoundaryConditions& bc, double step) const {
+  if (solver != s.solver || fluid_bulk_modulus != s.fluid_bulk_modulus || is_pressure != bc.is_pressure)
+    return true;
+  if (fluid_bulk_modulus > 0 && dt != step) return true;
+  if (solver == SolverKind::kCholesky &&
+      (ordering != s.factor_ordering() || mixed_precision != s.mixed_precision ||
+       mixed_precision_min_entries != s.mixed_precision_min_entries))
+    return true;
+  if (imposed_pressure_at.size() != bc.imposed_pressure.size() || imposed_flux_at.size() != bc.imposed_flux.size())
+    return true;
+  for (std::size_t i = 0; i < imposed_pressure_at.size(); ++i)
+    if (imposed_pressure_at[i] != bc.imposed_pressure[i].position) return true;
+  for (std::size_t i = 0; i < imposed_flux_at.size(); ++i)
+    if (imposed_flux_at[i] != bc.imposed_flux[i].position) return true;
+  return false;
+}
+
+const CholeskySolver* LinearSystem::cholesky() const { return dynamic_cast<const CholeskySolver*>(solver.get()); }
+CholeskySolver* LinearSystem::cholesky() { return dynamic_cast<CholeskySolver*>(solver.get()); }
+
+LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc, const EngineSettings& settings,
+                                 double dt, const CellOrdering* previous, std::unique_ptr<PressureSolver> recycled) {
+  LinearSystem l;
+  l.recipe = SystemRecipe(settings, bc, dt);
+  l.solver = recycled && recycled->kind() == settings.solver ? std::move(recycled) : make_solver(settings.solver);
+  if (settings.fluid_bulk_modulus > 0) {
+    l.storage.resize(m.mesh().n_cells());
+    for (int c = 0; c < m.mesh().n_cells(); ++c)
+      l.storage[c] = m.cells.fluid_volume[c] / (settings.fluid_bulk_modulus * dt);
+  }
+  for (const auto& c : bc.imposed_pressure) l.imposed_pressure_cells.push_back(m.tri.locate(c.position));
+  for (const auto& c : bc.imposed_flux) l.imposed_flux_cells.push_back(m.tri.locate(c.position));
+
+  auto t0 = StageClock::now();
+  l.system = assemble_pressure_system(m.mesh(), m.facets, m.k, bc, l.imposed_pressure_cells, l.storage);
+  const PressureSystem& s = l.system;
+  for (int u = 0; u < s.n_unknowns(); ++u) {
+    const int c = s.unknown_cell[u];
+    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e)
+      if (s.unknown[s.adj_cell[e]] < 0) {
+        l.coupling_unknown.push_back(u);
+        l.coupling_cell.push_back(s.adj_cell[e]);
+        l.coupling_k.push_back(s.adj_k[e]);
+      }
+  }
+  l.times.assembly = seconds_since(t0);
+
+  t0 = StageClock::now();
+  if (s.n_unknowns() > 0) {
+    if (CholeskySolver* cholesky = l.cholesky()) {
+      FactorOptions options;
+      options.ordering = settings.factor_ordering();
+      options.precision = settings.mixed_precision ? FactorPrecision::kScaled32 : FactorPrecision::kDouble;
+      options.min_scaled_entries = settings.mixed_precision_min_entries;
+      options.openmp_teams = settings.cholmod_openmp_teams;
+      if (previous && settings.reuse_ordering) {
+        options.given.perm = previous->carry_over(m.mesh(), s);
+        options.given.max_fill = settings.max_fill_growth * previous->fresh_fill();
+        options.given.from_metis = previous->from_metis();
+      }
+      cholesky->setup(s, options);
+      const CholmodSolver& f = cholesky->factor();
+      // The refinement's residual reads G by rows; a double factor never does.
+      if (f.reduced_precision()) index_rows(l.system);
+      if (f.ready() && f.permutation())
+        l.ordering = std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
+                                                          f.ordering_given() ? previous->fresh_fill() : f.fill(),
+                                                          f.metis_used());
+      l.times.analysis = f.analysis_seconds();
+    } else if (auto* pcg = dynamic_cast<PcgSolver*>(l.solver.get())) {
+      pcg->setup(s);
+    }
+  }
+  l.times.factorization = seconds_since(t0) - l.times.analysis;
+  return l;
+}
+
+}  // namespace pfv

@@ -1,0 +1,65 @@
+// The linear system of a pore mesh for given boundary conditions: G assembled over the unknown
+// cells (pressure_system.hpp) and a solver prepared for it (a factor, a preconditioner). Built
+// at every remesh, and again when the boundary conditions, the solver or its settings change;
+// like the pore mesh it touches nothing shared.
+#pragma once
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "pfv/engine/engine_settings.hpp"
+#include "pfv/engine/pore_mesh.hpp"
+#include "pfv/engine/stage_times.hpp"
+#include "pfv/linalg/ordering_reuse.hpp"
+#include "pfv/linalg/pressure_solver.hpp"
+#include "pfv/model/boundary_conditions.hpp"
+#include "pfv/model/pressure_system.hpp"
+
+namespace pfv {
+
+class CholeskySolver;
+
+// The settings and boundary conditions a linear system depends on.
+struct SystemRecipe {
+  SolverKind solver = SolverKind::kCholesky;
+  Ordering ordering = Ordering::kAuto;  // Cholesky only
+  bool mixed_precision = false;         // Cholesky only
+  double mixed_precision_min_entries = 0;
+  double fluid_bulk_modulus = 0;
+  double dt = 0;  // enters G only with a compressible fluid
+  std::array<bool, kWallCount> is_pressure{};
+  std::vector<Vec3> imposed_pressure_at, imposed_flux_at;
+
+  SystemRecipe() = default;
+  SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc, double dt);
+  // Whether a system built from this recipe must be rebuilt for these settings, boundary
+  // conditions and time step. Boundary values and imposed values are read at every step.
+  bool stale_for(const EngineSettings& s, const BoundaryConditions& bc, double dt) const;
+};
+
+struct LinearSystem {
+  PressureSystem system;
+  std::vector<int> coupling_unknown, coupling_cell;  // Dirichlet neighbours of unknowns
+  std::vector<double> coupling_k;
+  std::unique_ptr<PressureSolver> solver;  // null until built
+  std::shared_ptr<const CellOrdering> ordering;  // of a Cholesky factor, for the next remesh
+  std::vector<int> imposed_pressure_cells, imposed_flux_cells;
+  std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid
+  SystemRecipe recipe;
+  StageTimes times;  // assembly, analysis, factorization
+
+  bool ready() const { return solver && (system.n_unknowns() == 0 || solver->ready()); }
+  // The Cholesky solver, or nullptr with another solver.
+  const CholeskySolver* cholesky() const;
+  CholeskySolver* cholesky();
+};
+
+// Throws std::domain_error if the system is singular. previous: the ordering of the last
+// factorisation, tried first when settings.reuse_ordering (null: compute one). recycled: the
+// released solver of the previous system, reused (with the storage of its factor's values) if
+// it is of the kind the settings ask for.
+LinearSystem build_linear_system(const PoreMesh& mesh, const BoundaryConditions& bc, const EngineSettings& settings,
+                                 double dt, const CellOrdering* previous = nullptr,
+                                 std::unique_ptr<PressureSolver> recycled = nullptr);
+
+}  // namespace pfv

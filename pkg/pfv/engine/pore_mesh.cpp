@@ -1,0 +1,58 @@
+#include "pfv/engine/pore_mesh.hpp"
+
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include "pfv/common/stage_timer.hpp"
+#include "pfv/snapshot/snapshot.hpp"
+
+namespace pfv {
+
+bool MeshRecipe::stale_for(const EngineSettings& s) const {
+  const ConductanceModel& a = conductance;
+  const ConductanceModel& b = s.conductance;
+  return a.permeability_factor != b.permeability_factor || a.clamp != b.clamp || a.min_ratio != b.min_ratio ||
+         a.max_ratio != b.max_ratio || slip_boundary != s.slip_boundary || (s.viscous_shear && !viscous_shear);
+}
+
+PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                         const BoxWalls& walls, const EngineSettings& settings) {
+  check_distinct_centres(centres);
+
+  PoreMesh m(settings);
+  auto t0 = StageClock::now();
+  const Mesh& mesh = m.tri.build(centres, radii, walls);
+  const auto inside = m.tri.centres_inside_neighbours(centres, radii);
+  if (!inside.empty())
+    throw std::invalid_argument("sphere " + std::to_string(inside[0].first) + " and sphere " +
+                                std::to_string(inside[0].second) +
+                                " overlap so much that one centre lies inside the other sphere (" +
+                                std::to_string(inside.size()) + " such pairs); the pore mesh would be degenerate");
+  if (mesh.n_cells() == 0) throw std::invalid_argument("the triangulation has no pore cell");
+  m.times.triangulation = seconds_since(t0);
+
+  t0 = StageClock::now();
+  const Packing packing{centres, radii, walls};
+  m.cells = compute_cell_geometry(mesh, packing);
+  m.facets = compute_facet_geometry(mesh, m.cells, packing, settings.slip_boundary);
+  m.mean_cell_volume = std::accumulate(m.cells.volume.begin(), m.cells.volume.end(), 0.0) / mesh.n_cells();
+  m.times.geometry = seconds_since(t0);
+
+  t0 = StageClock::now();
+  m.k = throat_conductances(m.facets, settings.conductance);
+  m.times.conductance = seconds_since(t0);
+
+  t0 = StageClock::now();
+  m.cache.build(mesh, m.facets, packing);
+  m.times.force_cache = seconds_since(t0);
+
+  if (settings.viscous_shear) {
+    t0 = StageClock::now();
+    m.shear = build_viscous_shear(mesh, m.cells, m.facets, packing, !settings.slip_boundary);
+    m.times.shear_geometry = seconds_since(t0);
+  }
+  return m;
+}
+
+}  // namespace pfv

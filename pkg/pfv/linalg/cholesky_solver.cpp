@@ -1,0 +1,42 @@
+#include "pfv/linalg/cholesky_solver.hpp"
+
+#include <algorithm>
+
+namespace pfv {
+
+void CholeskySolver::setup(const PressureSystem& system, const FactorOptions& options) {
+  refinement_.reset();
+  factor_.set_openmp_teams(options.openmp_teams);
+  factor_.factorize(system, options.ordering, options.precision, options.given, options.min_scaled_entries);
+}
+
+SolveStats CholeskySolver::solve(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
+                                 const SolveControl& control) {
+  SolveStats stats;
+  if (!factor_.reduced_precision()) {
+    factor_.solve(b, x);
+    return stats;
+  }
+  if (refinement_.contraction() < 0 && contraction_seen_ > 0) refinement_.seed(contraction_seen_);
+  const bool converged =
+      refinement_.solve(system, factor_, b, x, control.refinement_tolerance, control.max_refinement_passes);
+  stats.refinement_passes = refinement_.passes();
+  if (converged) {
+    contraction_seen_ = std::max(contraction_seen_, refinement_.contraction());
+  } else {
+    factor_.promote_to_double(system);  // G too ill-conditioned for the 32-bit factor
+    factor_.solve(b, x);
+  }
+  return stats;
+}
+
+void CholeskySolver::apply_inverse(const PressureSystem&, const std::vector<double>& b, std::vector<double>& x,
+                                   const SolveControl&) const {
+  factor_.solve(b, x);
+}
+
+void CholeskySolver::carry_over(const CholeskySolver& previous) {
+  contraction_seen_ = std::max(contraction_seen_, previous.contraction_seen_);
+}
+
+}  // namespace pfv

@@ -1,0 +1,118 @@
+// Sparse Cholesky of G with CHOLMOD: analysed and factorised once per remesh, then only
+// forward/back substitution each step, into buffers allocated at factorisation.
+// Owns every CHOLMOD object it creates (YADE leaked factors here).
+#pragma once
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "pfv/linalg/parallel_substitution.hpp"
+
+namespace pfv {
+
+struct PressureSystem;
+
+// The elimination tree of a supernodal factor, in elimination positions: the columns of a
+// supernode form a chain ending at chain_end; parent[chain_end] is the first column below the
+// supernode's diagonal block (-1 at a root). Postordered, so every subtree is a contiguous
+// range of positions ending at its root.
+struct SupernodalChains {
+  std::vector<int> chain_end, parent;
+};
+
+// Fill-reducing ordering. kAuto is CHOLMOD's default (AMD, then METIS if AMD fills badly).
+enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
+
+// kScaled32 keeps the factor, computed in double, as 32-bit integers with one double scale per
+// column (in CHOLMOD's array): L(i, j) ~ q(i, j) * max_i |L(i, j)| / (2^31 - 1). Half the memory
+// traffic of a substitution, whose result is then only an approximate inverse, to be used
+// inside iterative refinement (refinement.hpp). The substitution still computes in double.
+//
+// Why not float: what limits an approximate factor inside refinement is its perturbation
+// relative to each column, and the entries of a column of L are of similar size. Rounding
+// them to float (24 bits relative to each entry) gives a contraction ||I - M^-1 G|| of
+// 2.5e-7 on the 10 000-sphere benchmark system, 32-bit integers relative to the column's
+// largest entry 1.2e-8 (2.7e-7 and 2e-8 at 50 000), for the same four bytes (doc/model.md,
+// "Solving G p = b"). One pass from the previous step's pressures then meets the default
+// tolerance; with float it needs two, and a second pass costs what the double solve saves.
+enum class FactorPrecision { kDouble, kScaled32 };
+
+// An elimination order of the unknowns to try before computing one (ordering_reuse.hpp): kept
+// if its factor has at most max_fill entries per unknown.
+struct GivenOrdering {
+  std::vector<int> perm;  // perm[k] = unknown eliminated k-th; empty: none
+  double max_fill = 0;
+  bool from_metis = false;  // where the order it descends from came from (for metis_used)
+};
+
+class CholmodSolver {
+ public:
+  CholmodSolver();
+  ~CholmodSolver();
+  CholmodSolver(const CholmodSolver&) = delete;
+  CholmodSolver& operator=(const CholmodSolver&) = delete;
+
+  // Throws std::domain_error if G is not positive definite. A kScaled32 request falls back to
+  // double when a column's scale is not a normal double (never for the pore networks; kept
+  // because the format's error bound assumes it).
+  // 'ordering' is computed unless 'given' is accepted.
+  // kScaled32 applies to factors of at least min_scaled_entries stored entries (after compaction).
+  void factorize(const PressureSystem& system, Ordering ordering,
+                 FactorPrecision precision = FactorPrecision::kDouble, const GivenOrdering& given = {},
+                 double min_scaled_entries = 0);
+  // Refactorises in double on the same ordering (no new analysis): for when refinement with
+  // the 32-bit factor does not converge (G too ill-conditioned for it).
+  void promote_to_double(const PressureSystem& system);
+  // x ~ G^-1 rhs; exact to round-off in double, an approximate inverse with kScaled32.
+  // Always PFV's own substitution (parallel_substitution.hpp) on the compacted factor, whose
+  // values CHOLMOD can no longer read: with two or more OpenMP threads on subtrees in parallel.
+  void solve(const std::vector<double>& rhs, std::vector<double>& x);
+  // See EngineSettings::cholmod_openmp_teams; applies to the factorisations that follow.
+  void set_openmp_teams(bool on) { openmp_teams_ = on; }
+  // The same on the calling thread only (the same arithmetic, the same result).
+  void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
+  bool reduced_precision() const { return !scale_.empty(); }  // the kScaled32 format
+  double parallel_top_fraction() const { return parallel_.top_fraction(); }
+  int shared_top_supernodes() const { return parallel_.shared_top_supernodes(); }
+  bool metis_used() const { return metis_used_; }
+  bool ordering_given() const { return ordering_given_; }  // the given order was kept
+  const int* permutation() const;  // unknown eliminated k-th, after CHOLMOD's postorder
+  double fill() const;             // factor entries per unknown
+  SupernodalChains chains() const;
+  bool ready() const { return factor_ != nullptr; }
+  double factor_nonzeros() const;
+  double factor_flops() const;
+  double analysis_seconds() const { return analysis_seconds_; }  // ordering + symbolic
+  // Frees the factor but keeps the storage of its values for the next factorize(), which
+  // reuses it when the new factor fits (see values_).
+  void release();
+  std::size_t value_capacity() const { return value_capacity_; }  // doubles, 0 before any factor
+
+ private:
+  void solve_on(const std::vector<double>& rhs, std::vector<double>& x, bool threads);
+  void numeric_factorization(const PressureSystem& system);
+  void lend_values(void* factor);  // cholmod_factor*, after the analysis
+  // Compacts the factor, converts it to kScaled32 if it has at least min_scaled_entries entries
+  // (kNever: stays double), and plans the substitution.
+  void plan_substitution(const PressureSystem& system, double min_scaled_entries);
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
+  struct Common;
+  Common* common_;
+  bool openmp_teams_ = false;
+  void* factor_ = nullptr;  // cholmod_factor*
+  // The factor's numeric values, lent to CHOLMOD (which otherwise allocates them afresh at
+  // every factorisation). A factor of 50 000 spheres takes about 480 MB before compaction;
+  // glibc serves blocks that large from new mappings, whose first touch faults in every
+  // 4 KiB page (1.5-20 us each on this VM). Kept across release(), it makes the pages of
+  // one remesh the pages of the next. Only grown, with 1/8 headroom for the next remeshes.
+  std::unique_ptr<double[]> values_;
+  std::size_t value_capacity_ = 0;
+  std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
+  std::vector<double> scale_;  // per column (elimination order) with kScaled32; empty in double
+  ParallelSubstitution parallel_;
+  bool metis_used_ = false;
+  bool ordering_given_ = false;
+  double analysis_seconds_ = 0;
+};
+
+}  // namespace pfv

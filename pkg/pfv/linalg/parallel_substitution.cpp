@@ -1,0 +1,418 @@
+#include "pfv/linalg/parallel_substitution.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <type_traits>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace pfv {
+namespace {
+
+// An entry as a double: 32-bit entries are converted here and scaled by their column's factor
+// by the caller, once per column, not once per entry.
+inline double value(double v) { return v; }
+inline double value(std::int32_t v) { return static_cast<double>(v); }
+
+// Dot product with eight partial sums (vectorises without -ffast-math).
+template <class Stored>
+inline double dot(const Stored* a, const double* b, int n) {
+  double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  int i = 0;
+  for (; i + 8 <= n; i += 8)
+    for (int k = 0; k < 8; ++k) s[k] += value(a[i + k]) * b[i + k];
+  for (; i < n; ++i) s[0] += value(a[i]) * b[i];
+  return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
+// Column j of a trapezoid block of nsrow rows, indexed by row (entries j..nsrow-1 exist).
+template <class Stored>
+inline const Stored* trapezoid_column(const Stored* block, std::ptrdiff_t nsrow, std::ptrdiff_t j) {
+  return block + j * nsrow - j * (j + 1) / 2;
+}
+
+// The scale of a block's column j: 1 for double entries (a constant the compiler folds).
+template <class Stored>
+inline double column_scale(const double* scale, int j) {
+  if constexpr (std::is_same_v<Stored, double>)
+    return 1.0;
+  else
+    return scale[j];
+}
+
+// u[i] -= sum over columns j in [j0, j1) of L(row0 + i, j) x[j], for i < count, four columns
+// per sweep over u: with one column per sweep the loads and stores of u, not the factor,
+// bound the narrow supernodes. The rows row0.. must lie below column j1 - 1's diagonal. x
+// holds x(j) times column j's scale.
+template <class Stored>
+inline void subtract_columns(const Stored* block, int nsrow, int j0, int j1, const double* x, int row0, double* u,
+                             int count) {
+  int j = j0;
+  for (; j + 4 <= j1; j += 4) {
+    const Stored* c0 = trapezoid_column(block, nsrow, j) + row0;
+    const Stored* c1 = trapezoid_column(block, nsrow, j + 1) + row0;
+    const Stored* c2 = trapezoid_column(block, nsrow, j + 2) + row0;
+    const Stored* c3 = trapezoid_column(block, nsrow, j + 3) + row0;
+    const double x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
+    for (int i = 0; i < count; ++i)
+      u[i] -= (value(c0[i]) * x0 + value(c1[i]) * x1) + (value(c2[i]) * x2 + value(c3[i]) * x3);
+  }
+  for (; j < j1; ++j) {
+    const Stored* col = trapezoid_column(block, nsrow, j) + row0;
+    const double xj = x[j];
+    for (int i = 0; i < count; ++i) u[i] -= value(col[i]) * xj;
+  }
+}
+
+// Columns [j0, j1) of the block's dense triangle, forwards, on u (the block's rows, from row
+// 0): u(j) /= L(j, j), then the rows j+1..j1-1 below it. Leaves u(j) * scale(j) in x.
+template <class Stored>
+inline void solve_triangle(const Stored* block, const double* scale, int nsrow, int j0, int j1, double* u,
+                           double* x) {
+  for (int j = j0; j < j1; ++j) {
+    const Stored* col = trapezoid_column(block, nsrow, j);
+    const double sj = column_scale<Stored>(scale, j);
+    const double xj = (u[j] /= value(col[j]) * sj) * sj;
+    x[j] = xj;
+    for (int i = j + 1; i < j1; ++i) u[i] -= value(col[i]) * xj;
+  }
+}
+
+// Each sweep reads the factor as one stream (forwards ascending, backwards descending), but
+// in short pieces (most supernodes are a few hundred bytes): the hardware prefetcher restarts
+// on each, and the sweep waits for memory. Asking for the bytes kPrefetchAhead beyond the
+// block being read, in the sweep's direction, keeps the stream going. Development
+// measurements, 10 000 spheres, factor out of cache: forward sweep 5.4 -> 4.0 ms in float and
+// 7.1 -> 5.7 ms in double, together with the four-column rectangle; backward sweep (32-bit
+// factor) 4.7-4.9 -> 3.5-3.6 ms at 10 000 and 36.7 -> 33.8 ms at 50 000, the same from 512 B
+// to 16 KB ahead. (An earlier trial of the backward prefetch, together with a four-column
+// backward sweep, had shown no gain.) doc/benchmarks.md has the project scripts' numbers.
+constexpr std::ptrdiff_t kPrefetchAhead = 2048;
+
+template <class Stored>
+inline void prefetch_ahead(const Stored* block, const Stored* block_end, const Stored* values_end) {
+  const char* a = reinterpret_cast<const char*>(block);
+  const char* z = reinterpret_cast<const char*>(block_end);
+  const char* end = reinterpret_cast<const char*>(values_end);
+  if (end - z <= kPrefetchAhead) return;  // the end of the stream: nothing to ask for
+  for (a += kPrefetchAhead, z += kPrefetchAhead; a < z; a += 64) __builtin_prefetch(a);
+}
+
+// The mirror image for the backward sweep: the block's byte range moved kPrefetchAhead down.
+template <class Stored>
+inline void prefetch_behind(const Stored* block, const Stored* block_end, const Stored* values_begin) {
+  const char* a = reinterpret_cast<const char*>(block);
+  const char* z = reinterpret_cast<const char*>(block_end);
+  const char* begin = reinterpret_cast<const char*>(values_begin);
+  if (a - begin <= kPrefetchAhead) return;  // the end of the stream
+  for (a -= kPrefetchAhead, z -= kPrefetchAhead; a < z; a += 64) __builtin_prefetch(a);
+}
+
+inline int thread_index() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
+inline int omp_team_size() {
+#ifdef _OPENMP
+  return omp_get_num_threads();
+#else
+  return 1;
+#endif
+}
+
+}  // namespace
+
+void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
+  L_ = f;
+  const int ns = f.nsuper;
+  std::vector<int> super_of(f.n);
+  for (int s = 0; s < ns; ++s)
+    for (int k = f.super[s]; k < f.super[s + 1]; ++k) super_of[k] = s;
+  std::vector<int> parent(ns, -1), first(ns);
+  std::vector<double> work(ns), subtree(ns);
+  std::vector<std::vector<int>> children(ns);
+  std::vector<int> roots;
+  std::size_t max_rows = 0;
+  for (int s = 0; s < ns; ++s) {
+    const int nscol = f.super[s + 1] - f.super[s], nsrow = f.pi[s + 1] - f.pi[s];
+    max_rows = std::max<std::size_t>(max_rows, nsrow);
+    work[s] = nscol * (nsrow - 0.5 * nscol);
+    if (nsrow > nscol) {
+      parent[s] = super_of[f.rows[f.pi[s] + nscol]];
+      children[parent[s]].push_back(s);
+    } else {
+      roots.push_back(s);
+    }
+  }
+  // Supernodes are postordered (children first), so subtrees are contiguous ranges.
+  for (int s = 0; s < ns; ++s) {
+    first[s] = s;
+    subtree[s] = work[s];
+  }
+  for (int s = 0; s < ns; ++s)
+    for (int c : children[s]) {
+      first[s] = std::min(first[s], first[c]);
+      subtree[s] += subtree[c];
+    }
+  const double total = std::accumulate(work.begin(), work.end(), 0.0);
+
+  // Split the heaviest open subtree until the groups balance (longest-processing-time).
+  std::vector<int> open = roots;
+  std::vector<char> is_top(ns, 0);
+  double top_work = 0;
+  std::vector<std::vector<int>> best_groups;
+  double best_time = total;  // time of the serial solve, in entries
+  for (int iteration = 0; iteration < ns && threads > 1; ++iteration) {
+    std::sort(open.begin(), open.end(), [&](int a, int b) { return subtree[a] > subtree[b]; });
+    std::vector<std::vector<int>> groups(threads);
+    std::vector<double> load(threads, 0.0);
+    for (int r : open) {
+      const int t = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+      groups[t].push_back(r);
+      load[t] += subtree[r];
+    }
+    const double time = top_work + *std::max_element(load.begin(), load.end());
+    if (time < best_time) {
+      best_time = time;
+      best_groups = groups;
+    }
+    if (open.empty() || top_work > 0.5 * total) break;
+    const int heaviest = open.front();
+    open.erase(open.begin());
+    is_top[heaviest] = 1;
+    top_work += work[heaviest];
+    open.insert(open.end(), children[heaviest].begin(), children[heaviest].end());
+  }
+
+  groups_.clear();
+  top_.clear();
+  std::vector<char> in_group(ns, 0);
+  for (const auto& g : best_groups) {
+    groups_.emplace_back();
+    for (int r : g) {
+      groups_.back().emplace_back(first[r], r);
+      for (int s = first[r]; s <= r; ++s) in_group[s] = 1;
+    }
+    std::sort(groups_.back().begin(), groups_.back().end());
+  }
+  if (groups_.empty()) groups_.emplace_back();  // one thread: everything is "top"
+  for (int s = 0; s < ns; ++s)
+    if (!in_group[s]) top_.push_back(s);
+  top_row_.assign(f.n, 0);
+  top_rows_.clear();
+  double top_entries = 0;
+  for (int s : top_) {
+    top_entries += work[s];
+    for (int k = f.super[s]; k < f.super[s + 1]; ++k) {
+      top_row_[k] = 1;
+      top_rows_.push_back(k);
+    }
+  }
+  top_fraction_ = total > 0 ? top_entries / total : 1;
+  shared_.clear();
+  for (int s : top_) shared_.push_back(threads > 1 && f.start[s + 1] - f.start[s] >= kMinSharedEntries);
+  const std::size_t buffers = std::max<std::size_t>(groups_.size(), threads);
+  acc_.assign(buffers, std::vector<double>(f.n, 0.0));
+  work_.assign(buffers, std::vector<double>(max_rows, 0.0));
+  scaled_.assign(f.scaled ? buffers : 0, std::vector<double>(max_rows, 0.0));
+  y_.assign(f.n, 0.0);
+}
+
+template <class Stored>
+void ParallelSubstitution::forward(const Stored* values, int s, int thread, bool top) {
+  const Block<Stored> b = block(values, s);
+  const int nrest = b.nsrow - b.nscol;
+  prefetch_ahead(b.L, values + L_.start[s + 1], values + L_.start[L_.nsuper]);
+  double* y = y_.data() + b.k1;  // this supernode's rows
+  double* x = y;                 // y(j) * scale(j), the same as y for double entries
+  if constexpr (!std::is_same_v<Stored, double>) x = scaled_[thread].data();
+  solve_triangle(b.L, b.scale, b.nsrow, 0, b.nscol, y, x);
+  // The rectangle below it: w = -L21 y1.
+  double* w = work_[thread].data();
+  std::fill(w, w + nrest, 0.0);
+  subtract_columns(b.L, b.nsrow, 0, b.nscol, x, b.nscol, w, nrest);
+  double* all = y_.data();
+  if (!top) {  // top rows are shared between threads: collect their updates apart
+    double* acc = acc_[thread].data();
+    for (int i = 0; i < nrest; ++i) {
+      if (top_row_[b.rows[i]])
+        acc[b.rows[i]] -= w[i];
+      else
+        all[b.rows[i]] += w[i];
+    }
+  } else {
+    for (int i = 0; i < nrest; ++i) all[b.rows[i]] += w[i];
+  }
+}
+
+template <class Stored>
+void ParallelSubstitution::backward(const Stored* values, int s, int thread) {
+  const Block<Stored> b = block(values, s);
+  const int nrest = b.nsrow - b.nscol;
+  prefetch_behind(b.L, values + L_.start[s + 1], values);
+  double* y = y_.data();
+  double* w = work_[thread].data();
+  for (int i = 0; i < nrest; ++i) w[i] = y[b.rows[i]];
+  y += b.k1;
+  for (int j = b.nscol - 1; j >= 0; --j) {
+    const Stored* col = trapezoid_column(b.L, b.nsrow, j);
+    const double sj = column_scale<Stored>(b.scale, j);
+    const double t = y[j] - (dot(col + b.nscol, w, nrest) + dot(col + j + 1, y + j + 1, b.nscol - j - 1)) * sj;
+    y[j] = t / (value(col[j]) * sj);
+  }
+}
+
+namespace {
+
+// The part [a, b) of the range [lo, hi) that thread t of nt takes.
+inline std::pair<int, int> share(int lo, int hi, int t, int nt) {
+  const long n = hi - lo;
+  return {lo + static_cast<int>(n * t / nt), lo + static_cast<int>(n * (t + 1) / nt)};
+}
+
+inline void barrier() {
+#pragma omp barrier
+}
+
+}  // namespace
+
+// The supernode's rows in one vector u (its own columns, then the rows below), solved by
+// blocks of kSharedBlock columns: the small triangle of a block on thread 0, then the update
+// of all rows below the block split between the threads. Every row sees the same operations
+// in the same order whatever nt is.
+template <class Stored>
+void ParallelSubstitution::forward_shared(const Stored* values, int s, int t, int nt) {
+  const Block<Stored> b = block(values, s);
+  double* y = y_.data();
+  double* u = work_[0].data();
+  double* x = u;
+  if constexpr (!std::is_same_v<Stored, double>) x = scaled_[0].data();
+  {
+    const auto [lo, hi] = share(0, b.nsrow, t, nt);
+    for (int i = lo; i < hi; ++i) u[i] = i < b.nscol ? y[b.k1 + i] : 0.0;
+  }
+  barrier();
+  for (int j0 = 0; j0 < b.nscol; j0 += kSharedBlock) {
+    const int j1 = std::min(j0 + kSharedBlock, b.nscol);
+    if (t == 0) solve_triangle(b.L, b.scale, b.nsrow, j0, j1, u, x);
+    barrier();
+    const auto [lo, hi] = share(j1, b.nsrow, t, nt);
+    subtract_columns(b.L, b.nsrow, j0, j1, x, lo, u + lo, hi - lo);
+    barrier();
+  }
+  const auto [lo, hi] = share(0, b.nsrow, t, nt);
+  for (int i = lo; i < hi; ++i) {  // the rows below belong to no other supernode of the top phase
+    if (i < b.nscol)
+      y[b.k1 + i] = u[i];
+    else
+      y[b.rows[i - b.nscol]] += u[i];  // u holds minus the update
+  }
+  barrier();
+}
+
+// Blocks from the last: the dots of a block's columns with the rows below it, split between
+// the threads by columns, then the block's triangle on thread 0.
+template <class Stored>
+void ParallelSubstitution::backward_shared(const Stored* values, int s, int t, int nt) {
+  const Block<Stored> b = block(values, s);
+  double* y = y_.data();
+  double* u = work_[0].data();
+  {
+    const auto [lo, hi] = share(0, b.nsrow, t, nt);
+    for (int i = lo; i < hi; ++i) u[i] = i < b.nscol ? y[b.k1 + i] : y[b.rows[i - b.nscol]];
+  }
+  barrier();
+  for (int j1 = b.nscol; j1 > 0;) {
+    const int j0 = std::max(0, j1 - kSharedBlock);
+    const auto [lo, hi] = share(j0, j1, t, nt);
+    for (int j = lo; j < hi; ++j)
+      u[j] -= dot(trapezoid_column(b.L, b.nsrow, j) + j1, u + j1, b.nsrow - j1) * column_scale<Stored>(b.scale, j);
+    barrier();
+    if (t == 0)
+      for (int j = j1 - 1; j >= j0; --j) {
+        const Stored* col = trapezoid_column(b.L, b.nsrow, j);
+        const double sj = column_scale<Stored>(b.scale, j);
+        u[j] = (u[j] - dot(col + j + 1, u + j + 1, j1 - j - 1) * sj) / (value(col[j]) * sj);
+      }
+    barrier();
+    j1 = j0;
+  }
+  const auto [lo, hi] = share(0, b.nscol, t, nt);
+  for (int i = lo; i < hi; ++i) y[b.k1 + i] = u[i];
+  barrier();
+}
+
+void ParallelSubstitution::solve(const double* b, double* x, bool parallel) {
+  if (L_.scaled)
+    solve_with(L_.scaled, b, x, parallel);
+  else
+    solve_with(L_.values, b, x, parallel);
+}
+
+template <class Stored>
+void ParallelSubstitution::solve_with(const Stored* values, const double* b, double* x, bool parallel) {
+  const int n = L_.n;
+  for (int k = 0; k < n; ++k) y_[k] = b[L_.perm[k]];
+  const int groups = static_cast<int>(groups_.size());
+  parallel = parallel && groups > 1;
+  const auto forward_group = [&](int g) {
+    for (const auto& [a, z] : groups_[g])
+      for (int s = a; s <= z; ++s) forward(values, s, g, false);
+  };
+  const auto backward_group = [&](int g) {
+    for (auto r = groups_[g].rbegin(); r != groups_[g].rend(); ++r)
+      for (int s = r->second; s >= r->first; --s) backward(values, s, g);
+  };
+  // A team smaller than asked for (a thread limit, a nested region) still covers every group.
+  if (parallel) {
+#pragma omp parallel num_threads(groups)
+    for (int g = thread_index(); g < groups; g += omp_team_size()) forward_group(g);
+  } else {
+    for (int g = 0; g < groups; ++g) forward_group(g);
+  }
+  for (int k : top_rows_)
+    for (int g = 0; g < groups; ++g) {
+      y_[k] -= acc_[g][k];
+      acc_[g][k] = 0;
+    }
+  // The top, on one thread except for the shared supernodes, whose pieces need all threads.
+  const auto top = [&](int t, int nt) {
+    const int nt_top = static_cast<int>(top_.size());
+    for (int k = 0; k < nt_top; ++k) {
+      if (shared_[k]) {
+        forward_shared(values, top_[k], t, nt);
+      } else {
+        if (t == 0) forward(values, top_[k], 0, true);
+        barrier();
+      }
+    }
+    for (int k = nt_top - 1; k >= 0; --k) {
+      if (shared_[k]) {
+        backward_shared(values, top_[k], t, nt);
+      } else {
+        if (t == 0) backward(values, top_[k], 0);
+        barrier();
+      }
+    }
+  };
+  if (parallel && std::find(shared_.begin(), shared_.end(), 1) != shared_.end()) {
+#pragma omp parallel num_threads(groups)
+    top(thread_index(), omp_team_size());
+  } else {
+    top(0, 1);
+  }
+  if (parallel) {
+#pragma omp parallel num_threads(groups)
+    for (int g = thread_index(); g < groups; g += omp_team_size()) backward_group(g);
+  } else {
+    for (int g = 0; g < groups; ++g) backward_group(g);
+  }
+  for (int k = 0; k < n; ++k) x[L_.perm[k]] = y_[k];
+}
+
+}  // namespace pfv

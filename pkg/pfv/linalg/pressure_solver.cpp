@@ -1,0 +1,17 @@
+#include "pfv/linalg/pressure_solver.hpp"
+
+namespace pfv {
+
+std::string_view to_string(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::kGaussSeidel:
+      return "gauss_seidel";
+    case SolverKind::kConjugateGradient:
+      return "conjugate_gradient";
+    case SolverKind::kCholesky:
+      return "cholesky";
+  }
+  return "unknown";
+}
+
+}  // namespace pfv

@@ -1,0 +1,58 @@
+// One interface for the three ways of solving G p = b over the unknown cells: Gauss-Seidel
+// (YADE's useSolver=0), conjugate gradients with an incomplete Cholesky preconditioner (a PFV
+// extension, useSolver=1) and the sparse Cholesky factor (useSolver=3, the default).
+//
+// A solver is prepared once per system (setup: a factorisation, a preconditioner, nothing)
+// and then solves many right-hand sides: one per DEM step between two remeshes.
+#pragma once
+#include <memory>
+#include <string_view>
+#include <vector>
+
+namespace pfv {
+
+struct PressureSystem;
+
+enum class SolverKind { kGaussSeidel, kConjugateGradient, kCholesky };
+
+std::string_view to_string(SolverKind kind);
+
+// Stopping rules; each solver reads the ones that concern it.
+struct SolveControl {
+  double tolerance = 1e-6;  // iterative solvers: Gauss-Seidel's max|dp|/max|p|, CG's |r|/|b|
+  double relax = 1.9;       // Gauss-Seidel over-relaxation
+  int max_iterations = 200000;
+  double refinement_tolerance = 1e-10;  // refinement with a 32-bit factor, relative to the spread of p
+  int max_refinement_passes = 8;
+};
+
+// What the last solve did, each count named for what it counts.
+struct SolveStats {
+  int sweeps = 0;             // Gauss-Seidel sweeps over the unknowns
+  int cg_iterations = 0;      // conjugate-gradient iterations
+  int refinement_passes = 0;  // refinement passes with a 32-bit factor (0 with a double factor)
+  bool converged = true;      // false: an iterative solver stopped at max_iterations
+};
+
+class PressureSolver {
+ public:
+  virtual ~PressureSolver() = default;
+  virtual SolverKind kind() const = 0;
+  // Ready for solve() on the system it was set up for.
+  virtual bool ready() const = 0;
+  // x (one entry per unknown) holds the start on entry and the solution on return; b includes
+  // the couplings to the Dirichlet cells.
+  virtual SolveStats solve(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
+                           const SolveControl& control) = 0;
+  // x ~ G^-1 b to the accuracy an eigenvalue estimate needs (1e-7 relative or better), from
+  // x = 0, without changing what the next solve() does: the stability limit's operator.
+  virtual void apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
+                             const SolveControl& control) const = 0;
+  // Whether the next solve() should start from pressures extrapolated from the last two steps
+  // rather than the last step's (refinement: it halves the first correction in a smooth motion).
+  virtual bool wants_extrapolated_start() const { return false; }
+  // Frees what was built for the last system, keeping what the next setup can reuse.
+  virtual void release() {}
+};
+
+}  // namespace pfv

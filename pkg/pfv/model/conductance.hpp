@@ -1,0 +1,25 @@
+// Throat conductances k_ij = g_ij / L_ij of the hydraulic-radius model (thesis 3.4-3.5):
+//   g = alpha * A_f * R_h^2 / mu,   alpha = permeability_factor / 2,
+// which is Poiseuille's pi r^4 / (8 mu) for a tube of radius r (R_h = r/2).
+#pragma once
+#include <vector>
+
+#include "triangulation/pore_geometry.hpp"
+
+namespace pfv {
+
+struct ConductanceModel {
+  double viscosity = 1.0;
+  double permeability_factor = 1.0;
+  // Optional clamping of k to [min_ratio, max_ratio] times the median k (YADE's clampKValues,
+  // minKdivKmean, maxKdivKmean, with a different reference; see doc/yade-differences.md). It
+  // also keeps flat (L = 0) and closed (A_f = 0) throats from making G singular.
+  bool clamp = true;
+  double min_ratio = 1e-4;
+  double max_ratio = 100.0;
+};
+
+// One value per facet; one-sided facets (no pore cell beyond) get 0.
+std::vector<double> throat_conductances(const FacetGeometry& facets, const ConductanceModel& model);
+
+}  // namespace pfv

@@ -1,0 +1,29 @@
+// Fluid forces as a fixed linear map of the cell pressures, F = S p (thesis 4.6, 5.1.4).
+//
+// Built once per remesh: for each (vertex, cell) pair the force per unit pressure in that
+// cell, gathering the sector pressure force (3.10), the viscous share of the facet's fluid
+// area split by wetted area (3.13 with the corrected sign, 3.14), and for walls the
+// projected footprint of the cell. Applying it is one pass, grouped by vertex so that
+// threads never write the same force.
+#pragma once
+#include <vector>
+
+#include "triangulation/mesh.hpp"
+#include "triangulation/pore_geometry.hpp"
+
+namespace pfv {
+
+class ForceCache {
+ public:
+  void build(const Mesh& mesh, const FacetGeometry& facets, const Packing& packing);
+  // force[v] for every mesh vertex (spheres, then the six walls).
+  void apply(const std::vector<double>& cell_pressure, std::vector<Vec3>& force) const;
+  int n_vertices() const { return static_cast<int>(start_.size()) - 1; }
+
+ private:
+  std::vector<int> start_;  // per vertex, into cell_/unit_
+  std::vector<int> cell_;
+  std::vector<Vec3> unit_;
+};
+
+}  // namespace pfv

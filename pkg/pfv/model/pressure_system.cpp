@@ -1,0 +1,159 @@
+#include "pfv/model/pressure_system.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace pfv {
+
+PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets,
+                                        const std::vector<double>& k,
+                                        const BoundaryConditions& bc,
+                                        const std::vector<int>& imposed_cells,
+                                        const std::vector<double>& storage) {
+  const int nc = mesh.n_cells();
+  PressureSystem s;
+  s.source.assign(nc, -1);
+  for (int c = 0; c < nc; ++c)
+    for (int v : mesh.cell_vertices[c])  // later walls win, as in YADE
+      if (mesh.is_wall(v) && bc.is_pressure[mesh.wall_of(v)]) s.source[c] = std::max(s.source[c], mesh.wall_of(v));
+  for (std::size_t i = 0; i < imposed_cells.size(); ++i)
+    if (imposed_cells[i] >= 0) s.source[imposed_cells[i]] = kWallCount + static_cast<int>(i);
+
+  s.unknown.assign(nc, -1);
+  for (int c = 0; c < nc; ++c)
+    if (s.source[c] < 0) {
+      s.unknown[c] = static_cast<int>(s.unknown_cell.size());
+      s.unknown_cell.push_back(c);
+    }
+
+  // Adjacency (CSR) from the two-sided facets.
+  s.adj_start.assign(nc + 1, 0);
+  for (int f = 0; f < facets.size(); ++f)
+    if (facets.cell[f][1] >= 0) {
+      ++s.adj_start[facets.cell[f][0] + 1];
+      ++s.adj_start[facets.cell[f][1] + 1];
+    }
+  std::partial_sum(s.adj_start.begin(), s.adj_start.end(), s.adj_start.begin());
+  s.adj_cell.resize(s.adj_start[nc]);
+  s.adj_k.resize(s.adj_start[nc]);
+  std::vector<int> fill(s.adj_start.begin(), s.adj_start.end() - 1);
+  s.diagonal.assign(nc, 0.0);
+  for (int f = 0; f < facets.size(); ++f) {
+    const int a = facets.cell[f][0], b = facets.cell[f][1];
+    if (b < 0) continue;
+    s.adj_cell[fill[a]] = b;
+    s.adj_k[fill[a]++] = k[f];
+    s.adj_cell[fill[b]] = a;
+    s.adj_k[fill[b]++] = k[f];
+    s.diagonal[a] += k[f];
+    s.diagonal[b] += k[f];
+  }
+
+  if (!storage.empty())
+    for (int c = 0; c < nc; ++c) s.diagonal[c] += storage[c];
+
+  // Every connected group of unknowns must reach a Dirichlet cell (or a compressible cell),
+  // else G is singular.
+  std::vector<char> reached(nc, 0);
+  std::vector<int> stack;
+  for (int c = 0; c < nc; ++c)
+    if (s.unknown[c] < 0 || (!storage.empty() && storage[c] > 0)) {
+      reached[c] = 1;
+      stack.push_back(c);
+    }
+  while (!stack.empty()) {
+    const int c = stack.back();
+    stack.pop_back();
+    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e)
+      if (s.adj_k[e] > 0 && !reached[s.adj_cell[e]]) {
+        reached[s.adj_cell[e]] = 1;
+        stack.push_back(s.adj_cell[e]);
+      }
+  }
+  const int isolated = static_cast<int>(std::count(reached.begin(), reached.end(), 0));
+  if (isolated > 0) {
+    const bool none = std::none_of(s.source.begin(), s.source.end(), [](int x) { return x >= 0; });
+    throw std::domain_error(
+        none ? "singular pressure system: no boundary has an imposed pressure (set "
+               "bndCondIsPressure on at least one wall, or imposePressure somewhere)"
+             : "singular pressure system: " + std::to_string(isolated) +
+                   " pore cells are not connected to any imposed pressure");
+  }
+
+  // Upper triangle by column over unknowns.
+  const int nu = s.n_unknowns();
+  s.col_start.assign(nu + 1, 0);
+  for (int u = 0; u < nu; ++u) {
+    const int c = s.unknown_cell[u];
+    int count = 1;
+    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e) {
+      const int v = s.unknown[s.adj_cell[e]];
+      if (v >= 0 && v < u) ++count;
+    }
+    s.col_start[u + 1] = s.col_start[u] + count;
+  }
+  s.row.resize(s.col_start[nu]);
+  s.value.resize(s.col_start[nu]);
+  std::vector<std::pair<int, double>> entries;
+  for (int u = 0; u < nu; ++u) {
+    const int c = s.unknown_cell[u];
+    int pos = s.col_start[u];
+    entries.clear();
+    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e) {
+      const int v = s.unknown[s.adj_cell[e]];
+      if (v >= 0 && v < u) entries.emplace_back(v, -s.adj_k[e]);
+    }
+    std::sort(entries.begin(), entries.end());
+    for (const auto& [r, x] : entries) {
+      s.row[pos] = r;
+      s.value[pos++] = x;
+    }
+    s.row[pos] = u;
+    s.value[pos] = s.diagonal[c];
+  }
+  return s;
+}
+
+void index_rows(PressureSystem& s) {
+  const int nu = s.n_unknowns();
+  std::vector<int> count(nu, 0);
+  for (int j = 0; j < nu; ++j)
+    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e)
+      if (s.row[e] != j) {
+        ++count[j];
+        ++count[s.row[e]];
+      }
+  const int w = nu > 0 ? *std::max_element(count.begin(), count.end()) : 0;
+  s.row_width = w;
+  s.row_column.resize(static_cast<std::size_t>(nu) * w);
+  s.row_value.assign(static_cast<std::size_t>(nu) * w, 0.0);
+  s.row_diagonal.assign(nu, 0.0);
+  for (int u = 0; u < nu; ++u) std::fill_n(s.row_column.begin() + static_cast<std::size_t>(u) * w, w, u);
+  std::fill(count.begin(), count.end(), 0);
+  for (int j = 0; j < nu; ++j)
+    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e) {
+      const int i = s.row[e];
+      if (i == j) {
+        s.row_diagonal[j] += s.value[e];
+        continue;
+      }
+      const std::size_t a = static_cast<std::size_t>(j) * w + count[j]++, b = static_cast<std::size_t>(i) * w + count[i]++;
+      s.row_column[a] = i;
+      s.row_value[a] = s.value[e];
+      s.row_column[b] = j;
+      s.row_value[b] = s.value[e];
+    }
+}
+
+void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc,
+                            std::vector<double>& p) {
+  for (std::size_t c = 0; c < s.source.size(); ++c) {
+    const int src = s.source[c];
+    if (src < 0) continue;
+    p[c] = src < kWallCount ? bc.value[src] : bc.imposed_pressure[src - kWallCount].value;
+  }
+}
+
+}  // namespace pfv

@@ -1,0 +1,58 @@
+// The linear system G p = -dV/dt + Q_q + Q_p over the pore cells (thesis 3.5).
+//
+// Cells touching a pressure wall, or holding an imposed pressure, are Dirichlet cells and
+// drop out of the unknowns; their pressures enter the right-hand side. G is symmetric
+// positive definite once every group of connected unknown cells reaches a Dirichlet cell;
+// assembly checks this and names the problem otherwise.
+#pragma once
+#include <vector>
+
+#include "pfv/model/boundary_conditions.hpp"
+#include "triangulation/mesh.hpp"
+#include "triangulation/pore_geometry.hpp"
+
+namespace pfv {
+
+struct PressureSystem {
+  // Per cell.
+  std::vector<int> unknown;  // index among unknowns, -1 for a Dirichlet cell
+  std::vector<int> source;   // Dirichlet source: wall w, or kWallCount + imposed point; else -1
+  std::vector<double> diagonal;  // sum of k over the cell's throats
+  // Cell adjacency through throats, both directions (CSR).
+  std::vector<int> adj_start, adj_cell;
+  std::vector<double> adj_k;
+  // Unknowns.
+  std::vector<int> unknown_cell;
+  // Upper triangle of G over the unknowns, compressed by column (row <= column).
+  std::vector<int> col_start, row;
+  std::vector<double> value;
+  // The same G by rows in a fixed width (ELLPACK; index_rows() below), for the residual of
+  // every refinement pass: unknown u's off-diagonal entries in slots u * row_width .. (u + 1) *
+  // row_width - 1, padded with (u, 0). A pore cell has at most four neighbours, so the width
+  // is 4 on a tetrahedral mesh, and each residual entry is a gather of its row, where the
+  // upper triangle by column needs a scattered read-modify-write for the lower half.
+  // Empty unless index_rows() was called: only a refined solve needs them.
+  int row_width = 0;
+  std::vector<int> row_column;
+  std::vector<double> row_value, row_diagonal;
+
+  int n_unknowns() const { return static_cast<int>(unknown_cell.size()); }
+};
+
+// imposed_cells[k] is the cell of bc.imposed_pressure[k] (-1 if it lies in no cell).
+// storage (optional, per cell) adds V_i / (K dt) to the diagonal: fluid compressibility.
+PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets,
+                                        const std::vector<double>& k,
+                                        const BoundaryConditions& bc,
+                                        const std::vector<int>& imposed_cells,
+                                        const std::vector<double>& storage = {});
+
+// Fills row_width, row_column, row_value and row_diagonal from col_start, row and value
+// (build_linear_system does it for a 32-bit factor, whose refinement reads them).
+void index_rows(PressureSystem& s);
+
+// Pressures of the Dirichlet cells from the current boundary values (cheap; every step).
+void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc,
+                            std::vector<double>& pressure);
+
+}  // namespace pfv

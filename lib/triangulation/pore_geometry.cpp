@@ -20,12 +20,12 @@ Vec3 unit_or_zero(const Vec3& v) {
 // or two vertices are walls (a trapezoid or a rectangle reaching the wall planes).
 struct FacetPolygon {
   int n_real = 0;
-  std::array<int, 3> real{};   // sphere ids
-  std::array<int, 3> slot{};   // position of each sphere in the facet's vertex triple
+  std::array<int, 3> real{};  // sphere ids
+  std::array<int, 3> slot{};  // position of each sphere in the facet's vertex triple
   int n_walls = 0;
-  std::array<int, 3> wall{};   // wall indices
+  std::array<int, 3> wall{};  // wall indices
   std::array<int, 3> wall_slot{};
-  Vec3 area = Vec3::Zero();    // unoriented area vector
+  Vec3 area = Vec3::Zero();                        // unoriented area vector
   std::array<std::array<Vec3, 2>, 3> edge{};       // unit edge directions at each sphere
   std::array<std::array<Vec3, 2>, 3> wall_edge{};  // the polygon's side lying on each wall
 };
@@ -165,8 +165,7 @@ double cell_volume(const CellShape& s, const std::vector<Vec3>& c, const BoxWall
       const int axis = 3 - wall_axis(w1) - wall_axis(w2);
       const double h1a = W.height(w1, a), h1b = W.height(w1, b);
       const double h2a = W.height(w2, a), h2b = W.height(w2, b);
-      return std::abs(b[axis] - a[axis]) *
-             ((h1a * h2a + h1b * h2b) / 3.0 + (h1a * h2b + h1b * h2a) / 6.0);
+      return std::abs(b[axis] - a[axis]) * ((h1a * h2a + h1b * h2b) / 3.0 + (h1a * h2b + h1b * h2a) / 6.0);
     }
     case 3: {
       const Vec3& a = c[s.v[0]];
@@ -200,15 +199,14 @@ CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& pk) {
   return g;
 }
 
-Vec3 facet_area_vector(const Mesh& mesh, const std::array<int, 3>& facet, int opposite,
-                       const Packing& pk) {
+Vec3 facet_area_vector(const Mesh& mesh, const std::array<int, 3>& facet, int opposite, const Packing& pk) {
   const FacetPolygon f = make_polygon(mesh, facet, pk);
   const Vec3 dir = away_from(mesh, f, opposite, pk);
   return f.area.dot(dir) < 0 ? Vec3(-f.area) : f.area;
 }
 
-FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells,
-                                     const Packing& pk, bool slip_boundary) {
+FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells, const Packing& pk,
+                                     bool slip_boundary) {
   FacetGeometry g;
   // Each facet once: from its lower-numbered pore cell, or from its only pore cell.
   for (int i = 0; i < mesh.n_cells(); ++i)

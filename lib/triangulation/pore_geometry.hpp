@@ -41,7 +41,7 @@ struct FacetGeometry {
   std::vector<std::array<int, 3>> vertex;  // mesh vertex ids (walls: n_spheres + w)
   std::vector<Vec3> area_vector;           // |S| times the unit normal from cell 0 to cell 1
   std::vector<double> fluid_area;
-  std::vector<double> length;              // |P_0 P_1|; 0 for a one-sided facet
+  std::vector<double> length;  // |P_0 P_1|; 0 for a one-sided facet
   std::vector<double> hydraulic_radius;
   std::vector<std::array<double, 3>> sector_area;  // A^k, scaled down if they exceed the facet
   std::vector<std::array<double, 3>> wetted_area;  // gamma^k
@@ -62,8 +62,8 @@ double cell_volume(const CellShape& s, const std::vector<Vec3>& centre, const Bo
 
 CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& packing);
 
-FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells,
-                                     const Packing& packing, bool slip_boundary);
+FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells, const Packing& packing,
+                                     bool slip_boundary);
 
 // Projected area of a cell on each of its walls, as outward force vectors per unit
 // pressure (the wall part of the force cache). Entry k is for local vertex k of the cell;
@@ -72,7 +72,6 @@ std::array<Vec3, 4> wall_footprints(const Mesh& mesh, int cell, const Packing& p
 
 // The polygon of a facet (triangle, wall trapezoid or wall rectangle) as an area vector
 // oriented away from the vertex 'opposite' of the owning cell.
-Vec3 facet_area_vector(const Mesh& mesh, const std::array<int, 3>& facet, int opposite,
-                       const Packing& packing);
+Vec3 facet_area_vector(const Mesh& mesh, const std::array<int, 3>& facet, int opposite, const Packing& packing);
 
 }  // namespace pfv

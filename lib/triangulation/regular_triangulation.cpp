@@ -18,8 +18,7 @@ using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, CGAL::Regular_tri
 // Hidden points are not needed (they are reported from vertex info), so do not store them.
 using Cb = CGAL::Triangulation_cell_base_with_info_3<
     int, K,
-    CGAL::Regular_triangulation_cell_base_3<K, CGAL::Triangulation_cell_base_3<K>,
-                                            CGAL::Discard_hidden_points>>;
+    CGAL::Regular_triangulation_cell_base_3<K, CGAL::Triangulation_cell_base_3<K>, CGAL::Discard_hidden_points>>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
 using RT = CGAL::Regular_triangulation_3<K, Tds>;
 using WPoint = RT::Weighted_point;
@@ -35,8 +34,8 @@ RegularTriangulation::~RegularTriangulation() = default;
 RegularTriangulation::RegularTriangulation(RegularTriangulation&&) noexcept = default;
 RegularTriangulation& RegularTriangulation::operator=(RegularTriangulation&&) noexcept = default;
 
-const Mesh& RegularTriangulation::build(const std::vector<Vec3>& centres,
-                                        const std::vector<double>& radii, const BoxWalls& walls) {
+const Mesh& RegularTriangulation::build(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                                        const BoxWalls& walls) {
   const int n = static_cast<int>(centres.size());
   RT& rt = impl_->rt;
   rt.clear();
@@ -52,9 +51,7 @@ const Mesh& RegularTriangulation::build(const std::vector<Vec3>& centres,
   std::vector<std::pair<WPoint, int>> points;
   points.reserve(n + kWallCount);
   for (int k = 0; k < n; ++k)
-    points.emplace_back(WPoint(K::Point_3(centres[k].x(), centres[k].y(), centres[k].z()),
-                               radii[k] * radii[k]),
-                        k);
+    points.emplace_back(WPoint(K::Point_3(centres[k].x(), centres[k].y(), centres[k].z()), radii[k] * radii[k]), k);
   for (int w = 0; w < kWallCount; ++w) {
     Vec3 c = mid;
     c[wall_axis(w)] = walls.coord[w];

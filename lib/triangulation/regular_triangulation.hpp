@@ -26,8 +26,7 @@ class RegularTriangulation {
   RegularTriangulation& operator=(const RegularTriangulation&) = delete;
 
   // Rebuilds from scratch (bulk insertion with spatial sorting) and returns the pore mesh.
-  const Mesh& build(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                    const BoxWalls& walls);
+  const Mesh& build(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls);
 
   const Mesh& mesh() const { return mesh_; }
 
@@ -36,8 +35,8 @@ class RegularTriangulation {
 
   // Pairs of spheres with one centre inside the other sphere: neighbours in the
   // triangulation, and each hidden sphere with the sphere that hides it.
-  std::vector<std::pair<int, int>> centres_inside_neighbours(
-      const std::vector<Vec3>& centres, const std::vector<double>& radii) const;
+  std::vector<std::pair<int, int>> centres_inside_neighbours(const std::vector<Vec3>& centres,
+                                                             const std::vector<double>& radii) const;
 
  private:
   struct Impl;

@@ -14,8 +14,6 @@ inline double solid_angle(const Vec3& e1, const Vec3& e2, const Vec3& e3) {
 }
 
 // Planar angle between two unit directions.
-inline double planar_angle(const Vec3& e1, const Vec3& e2) {
-  return std::atan2(e1.cross(e2).norm(), e1.dot(e2));
-}
+inline double planar_angle(const Vec3& e1, const Vec3& e2) { return std::atan2(e1.cross(e2).norm(), e1.dot(e2)); }
 
 }  // namespace pfv

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "pfv/linalg/cholmod_solver.hpp"
 #include "pfv/engine/flow_engine.hpp"
+#include "pfv/linalg/cholmod_solver.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;
@@ -72,8 +72,8 @@ TEST(Extremes, RadiusRatioOneToTen) {
 }
 
 TEST(Extremes, LooseAndDensePackings) {
-  expect_sound(test::random_packing(60, 43, 0.04, 0.05), permeameter(1));   // porosity ~0.97
-  expect_sound(lattice(6, true, 0.999), permeameter(1));                     // FCC, nearly touching: n ~ 0.26
+  expect_sound(test::random_packing(60, 43, 0.04, 0.05), permeameter(1));  // porosity ~0.97
+  expect_sound(lattice(6, true, 0.999), permeameter(1));                   // FCC, nearly touching: n ~ 0.26
 }
 
 TEST(Extremes, DegenerateLattices) {
@@ -86,7 +86,7 @@ TEST(Extremes, DegenerateLattices) {
 
 TEST(Extremes, SpheresTouchingAndOverlappingWalls) {
   auto p = test::random_packing(200, 44);
-  p.centre[0].y() = p.radius[0];          // touching ymin
+  p.centre[0].y() = p.radius[0];            // touching ymin
   p.centre[1].x() = 1 - 0.5 * p.radius[1];  // overlapping xmax by half a radius
   p.centre[2].z() = 0.1 * p.radius[2];      // centre just inside zmin
   expect_sound(p, permeameter(1));

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "pfv/model/conductance.hpp"
 #include "pfv/engine/flow_engine.hpp"
+#include "pfv/model/conductance.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;
@@ -147,7 +147,7 @@ TEST(FlowModel, InternalRearrangementExpelsNothing) {
   for (double x : e.pressure()) pmax = std::max(pmax, std::abs(x));
   EXPECT_GT(pmax, 0);
   const double each = std::max(std::abs(e.boundary_flux(2)), std::abs(e.boundary_flux(3)));
-  EXPECT_GT(each, 0);  // fluid does cross each drained wall...
+  EXPECT_GT(each, 0);                                                         // fluid does cross each drained wall...
   EXPECT_LT(std::abs(e.boundary_flux(2) + e.boundary_flux(3)), 1e-8 * each);  // ...but in equal amounts
 }
 
@@ -246,7 +246,7 @@ TEST(FlowEngine, FailedBackgroundRemeshSurfacesAndRecovers) {
   e.step(p.centre, p.radius, p.walls, 1.0);
   e.step(p.centre, p.radius, p.walls, 1.0);
   auto bad = p;
-  bad.centre[1] = bad.centre[2];  // coincident: only the remesh can see it
+  bad.centre[1] = bad.centre[2];                   // coincident: only the remesh can see it
   e.step(bad.centre, bad.radius, bad.walls, 1.0);  // launches the background remesh
   e.wait_for_remesh();
   try {
@@ -328,5 +328,6 @@ TEST(FlowModel, StiffFluidTendsToTheIncompressibleSolution) {
   for (FlowEngine* e : {&inc, &comp}) e->step(p.centre, p.radius, p.walls, 1e-3);
   double pmax = 0;
   for (double x : inc.pressure()) pmax = std::max(pmax, std::abs(x));
-  for (std::size_t c = 0; c < inc.pressure().size(); ++c) EXPECT_NEAR(comp.pressure()[c], inc.pressure()[c], 1e-6 * pmax);
+  for (std::size_t c = 0; c < inc.pressure().size(); ++c)
+    EXPECT_NEAR(comp.pressure()[c], inc.pressure()[c], 1e-6 * pmax);
 }

@@ -1,8 +1,8 @@
 // Every CGAL and CHOLMOD resource is owned: thousands of remeshes must not grow memory.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <unistd.h>
+#include <fstream>
 
 #include "pfv/engine/flow_engine.hpp"
 #include "test_packings.hpp"

@@ -312,7 +312,7 @@ TEST(MixedPrecision, ResidualByRowsEqualsResidualByColumns) {
     g_x *= max_abs(x);
     double diff = 0;
     for (int i = 0; i < n; ++i) diff = std::max(diff, std::abs(r_rows[i] - r_columns[i]));
-    EXPECT_LE(diff, 1e-14 * 5 * g_x);  // five terms per row, each rounded once
+    EXPECT_LE(diff, 1e-14 * 5 * g_x);        // five terms per row, each rounded once
     EXPECT_GT(max_abs(r_rows), 1e-3 * g_x);  // not a vanishing residual
   }
 }

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <numeric>
 
-#include "triangulation/regular_triangulation.hpp"
 #include "test_packings.hpp"
+#include "triangulation/regular_triangulation.hpp"
 
 using namespace pfv;
 

@@ -25,6 +25,4 @@ TEST(SolidAngle, ObtuseConeBeyondAHemisphereFace) {
   EXPECT_LT(om, 2 * M_PI);
 }
 
-TEST(PlanarAngle, RightAngle) {
-  EXPECT_NEAR(pfv::planar_angle(Vec3::UnitX(), Vec3::UnitY()), M_PI / 2, 1e-15);
-}
+TEST(PlanarAngle, RightAngle) { EXPECT_NEAR(pfv::planar_angle(Vec3::UnitX(), Vec3::UnitY()), M_PI / 2, 1e-15); }

@@ -3,8 +3,8 @@
 #include <random>
 #include <vector>
 
-#include "triangulation/box_walls.hpp"
 #include "pfv/engine/flow_engine.hpp"
+#include "triangulation/box_walls.hpp"
 #include "triangulation/vec3.hpp"
 
 namespace pfv::test {
@@ -25,8 +25,7 @@ inline TestPacking random_packing(int n, unsigned seed, double rmin = 0.03, doub
     const double r = rmin + (rmax - rmin) * u(gen);
     const Vec3 x(r + (1 - 2 * r) * u(gen), r + (1 - 2 * r) * u(gen), r + (1 - 2 * r) * u(gen));
     bool free = true;
-    for (std::size_t k = 0; k < p.centre.size() && free; ++k)
-      free = (x - p.centre[k]).norm() > r + p.radius[k];
+    for (std::size_t k = 0; k < p.centre.size() && free; ++k) free = (x - p.centre[k]).norm() > r + p.radius[k];
     if (free) {
       p.centre.push_back(x);
       p.radius.push_back(r);

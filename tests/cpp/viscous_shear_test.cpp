@@ -7,8 +7,8 @@
 
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/model/force_cache.hpp"
-#include "test_packings.hpp"
 #include "pfv/model/viscous_shear.hpp"
+#include "test_packings.hpp"
 
 using namespace pfv;
 using test::permeameter;
@@ -173,8 +173,7 @@ TEST(ViscousShear, SimpleShearOfTwoSpheresByHand) {
   const double mu = 0.7, gamma_dot = 2.0, dt = 1e-4;
   FlowEngine e = shear_engine(true, mu);
   e.step(p.centre, p.radius, p.walls, dt);
-  e.step(moved(p.centre, dt, [&](const Vec3& x, int) { return Vec3(gamma_dot * x.y(), 0, 0); }), p.radius, p.walls,
-         dt);
+  e.step(moved(p.centre, dt, [&](const Vec3& x, int) { return Vec3(gamma_dot * x.y(), 0, 0); }), p.radius, p.walls, dt);
 
   const ViscousShear& s = *e.viscous_shear();
   ASSERT_EQ(s.size(), 1);
@@ -206,8 +205,8 @@ TEST(ViscousShear, SimpleShearOfTwoSpheresByHand) {
   FlowEngine off = permeameter(1, 0.0);
   off.settings.conductance.viscosity = mu;
   off.step(p.centre, p.radius, p.walls, dt);
-  off.step(moved(p.centre, dt, [&](const Vec3& x, int) { return Vec3(gamma_dot * x.y(), 0, 0); }), p.radius,
-           p.walls, dt);
+  off.step(moved(p.centre, dt, [&](const Vec3& x, int) { return Vec3(gamma_dot * x.y(), 0, 0); }), p.radius, p.walls,
+           dt);
   EXPECT_NEAR(e.forces()[0].x() - off.forces()[0].x(), fx, 1e-9 * fx);
 }
 

@@ -25,8 +25,7 @@ void validate(const EngineSettings& s) {
   require(s.mixed_precision_min_entries >= 0 && std::isfinite(s.mixed_precision_min_entries),
           "mixed_precision_min_entries must be finite and >= 0");
   require(s.refinement_tolerance > 0 && s.refinement_tolerance < 1, "refinement_tolerance must be in (0, 1)");
-  require(s.fluid_bulk_modulus >= 0 && std::isfinite(s.fluid_bulk_modulus),
-          "fluidBulkModulus must be >= 0 and finite");
+  require(s.fluid_bulk_modulus >= 0 && std::isfinite(s.fluid_bulk_modulus), "fluidBulkModulus must be >= 0 and finite");
 }
 
 }  // namespace pfv

@@ -97,18 +97,18 @@ void FlowEngine::adopt_finished_remesh() {
 void FlowEngine::remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii,
                                       const BoxWalls& walls, double dt) {
   // Snapshot now, build on another thread, carry on with the current mesh meanwhile.
-  pending_ = Pending{std::async(std::launch::async, [c = centres, r = radii, w = walls, s = settings, b = bc, dt,
-                                                     o = linear_.ordering]() {
-    PoreMesh m = build_pore_mesh(c, r, w, s);
-    LinearSystem l = build_linear_system(m, b, s, dt, o.get());
-    return Remesh(std::move(m), std::move(l));
-  })};
+  pending_ = Pending{std::async(std::launch::async,
+                                [c = centres, r = radii, w = walls, s = settings, b = bc, dt, o = linear_.ordering]() {
+                                  PoreMesh m = build_pore_mesh(c, r, w, s);
+                                  LinearSystem l = build_linear_system(m, b, s, dt, o.get());
+                                  return Remesh(std::move(m), std::move(l));
+                                })};
   strain_ = 0;
   steps_since_remesh_ = 0;
 }
 
-void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                            const BoxWalls& walls, double dt) {
+void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                            double dt) {
   PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
   // Free the old factor first (the largest object: peak memory is then one factor, not two).
   // Should the new system fail, the old mesh is kept without a solver and the next step starts
@@ -284,7 +284,8 @@ double FlowEngine::boundary_flux(int wall) const {
   double q = 0;
   for (std::size_t c = 0; c < s.source.size(); ++c) {
     if (s.source[c] != wall) continue;
-    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e) q += s.adj_k[e] * (pressure_[s.adj_cell[e]] - pressure_[c]);
+    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e)
+      q += s.adj_k[e] * (pressure_[s.adj_cell[e]] - pressure_[c]);
     if (c < volume_rate_.size()) q -= volume_rate_[c];
   }
   return q;

@@ -117,10 +117,9 @@ class FlowEngine {
   void commit(const std::vector<Vec3>& centres, const BoxWalls& walls, double strain);
 
   void adopt_finished_remesh();
-  void remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                            const BoxWalls& walls, double dt);
-  void remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
-                  double dt);
+  void remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                            double dt);
+  void remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
   void adopt(PoreMesh&& mesh, LinearSystem&& linear);
   // The current system's solver with its factor freed, handed over to the next build (the
   // storage of the factor's values is reused): peak memory one factor, no new pages to fault.
@@ -133,8 +132,8 @@ class FlowEngine {
   std::vector<double> pressure_, volume_, volume_rate_, rhs_, solution_;
   std::vector<Vec3> force_;
   std::vector<double> next_volume_, next_pressure_;  // scratch of the step being computed
-  std::vector<double> pressure_before_;  // the step before pressure_'s, on this mesh (extrapolated start)
-  bool keep_trend_ = false;              // the solver of this step wants the extrapolated start next
+  std::vector<double> pressure_before_;              // the step before pressure_'s, on this mesh (extrapolated start)
+  bool keep_trend_ = false;                          // the solver of this step wants the extrapolated start next
   std::vector<Vec3> next_force_;
   std::vector<Vec3> shear_force_, next_shear_;  // only with viscous_shear
   std::vector<Vec3> centres_prev_;

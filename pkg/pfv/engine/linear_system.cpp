@@ -41,12 +41,10 @@ SystemRecipe::SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc
       imposed_flux_at(positions(bc.imposed_flux)) {}
 
 bool SystemRecipe::stale_for(const EngineSettings& s, const BoundaryConditions& bc, double step) const {
-  if (solver != s.solver || fluid_bulk_modulus != s.fluid_bulk_modulus || is_pressure != bc.is_pressure)
-    return true;
+  if (solver != s.solver || fluid_bulk_modulus != s.fluid_bulk_modulus || is_pressure != bc.is_pressure) return true;
   if (fluid_bulk_modulus > 0 && dt != step) return true;
-  if (solver == SolverKind::kCholesky &&
-      (ordering != s.factor_ordering() || mixed_precision != s.mixed_precision ||
-       mixed_precision_min_entries != s.mixed_precision_min_entries))
+  if (solver == SolverKind::kCholesky && (ordering != s.factor_ordering() || mixed_precision != s.mixed_precision ||
+                                          mixed_precision_min_entries != s.mixed_precision_min_entries))
     return true;
   if (imposed_pressure_at.size() != bc.imposed_pressure.size() || imposed_flux_at.size() != bc.imposed_flux.size())
     return true;

@@ -41,7 +41,7 @@ struct LinearSystem {
   PressureSystem system;
   std::vector<int> coupling_unknown, coupling_cell;  // Dirichlet neighbours of unknowns
   std::vector<double> coupling_k;
-  std::unique_ptr<PressureSolver> solver;  // null until built
+  std::unique_ptr<PressureSolver> solver;        // null until built
   std::shared_ptr<const CellOrdering> ordering;  // of a Cholesky factor, for the next remesh
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;
   std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid

@@ -16,8 +16,8 @@ bool MeshRecipe::stale_for(const EngineSettings& s) const {
          a.max_ratio != b.max_ratio || slip_boundary != s.slip_boundary || (s.viscous_shear && !viscous_shear);
 }
 
-PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                         const BoxWalls& walls, const EngineSettings& settings) {
+PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                         const EngineSettings& settings) {
   check_distinct_centres(centres);
 
   PoreMesh m(settings);

@@ -45,7 +45,7 @@ struct PoreMesh {
 };
 
 // Throws std::invalid_argument for coincident centres or a centre inside another sphere.
-PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                         const BoxWalls& walls, const EngineSettings& settings);
+PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                         const EngineSettings& settings);
 
 }  // namespace pfv

@@ -29,8 +29,8 @@ double dot(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
 }
 
 // Relative change below which the estimate counts as settled.
-constexpr double kWarmSettled = 5e-3;   // power iteration from the previous mode
-constexpr double kColdSettled = 1e-6;   // Ritz value between two Krylov dimensions
+constexpr double kWarmSettled = 5e-3;  // power iteration from the previous mode
+constexpr double kColdSettled = 1e-6;  // Ritz value between two Krylov dimensions
 constexpr int kMinKrylov = 8;
 
 }  // namespace
@@ -64,15 +64,14 @@ void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const s
   for (int k = 0; k < n; ++k) accel[k] = mass[k] > 0 ? Vec3(force[k] / mass[k]) : Vec3::Zero();
 }
 
-double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations,
-                                           std::vector<Vec3>* mode, int* applications) const {
+double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode,
+                                           int* applications) const {
   if (applications) *applications = 0;
   if (!has_mesh() || !has_prev_) throw std::logic_error("the stability limit needs a mesh: run a step first");
   const int n = mesh().n_spheres;
   if (static_cast<int>(mass.size()) != n) throw std::invalid_argument("one mass per sphere is needed");
   for (int k = 0; k < n; ++k)
-    if (!std::isfinite(mass[k]))
-      throw std::invalid_argument("mass of sphere " + std::to_string(k) + " is not finite");
+    if (!std::isfinite(mass[k])) throw std::invalid_argument("mass of sphere " + std::to_string(k) + " is not finite");
   const int nu = linear_.system.n_unknowns();
   if (nu == 0 || !linear_.ready()) return HUGE_VAL;
 
@@ -104,7 +103,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
       ++applied;
       const double previous = lambda;
       lambda = std::sqrt(dot(w, w));  // |M^-1 V v| for |v| = 1
-      if (lambda == 0) break;  // no fluid force for any motion: no limit
+      if (lambda == 0) break;         // no fluid force for any motion: no limit
       v.swap(w);
       for (Vec3& u : v) u /= lambda;
       if (it >= 2 && std::abs(lambda - previous) <= kWarmSettled * lambda) break;
@@ -149,8 +148,9 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
   if (applications) *applications = applied;
   if (lambda == 0) return HUGE_VAL;
   if (!std::isfinite(lambda))
-    throw std::domain_error("the collective viscous stability limit is not finite (the linearised fluid operator "
-                            "gave NaN or infinity: check the positions, masses and viscosity)");
+    throw std::domain_error(
+        "the collective viscous stability limit is not finite (the linearised fluid operator "
+        "gave NaN or infinity: check the positions, masses and viscosity)");
   if (mode) *mode = std::move(v);
   return 2.0 / lambda;
 }

@@ -13,8 +13,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "pfv/model/pressure_system.hpp"
 #include "pfv/linalg/serial_openmp.hpp"
+#include "pfv/model/pressure_system.hpp"
 
 namespace pfv {
 
@@ -49,9 +49,7 @@ void CholmodSolver::release() {
   parallel_ = ParallelSubstitution{};  // it points into the factor just freed
 }
 
-double CholmodSolver::factor_nonzeros() const {
-  return factor_ ? common_->c.lnz : 0.0;
-}
+double CholmodSolver::factor_nonzeros() const { return factor_ ? common_->c.lnz : 0.0; }
 
 const int* CholmodSolver::permutation() const {
   return factor_ ? static_cast<const int*>(static_cast<const cholmod_factor*>(factor_)->Perm) : nullptr;
@@ -79,9 +77,7 @@ double CholmodSolver::fill() const {
   return factor_ ? common_->c.lnz / static_cast<double>(static_cast<const cholmod_factor*>(factor_)->n) : 0.0;
 }
 
-double CholmodSolver::factor_flops() const {
-  return factor_ ? common_->c.fl : 0.0;
-}
+double CholmodSolver::factor_flops() const { return factor_ ? common_->c.fl : 0.0; }
 
 namespace {
 
@@ -105,7 +101,7 @@ cholmod_sparse view_of(const PressureSystem& s) {
 }  // namespace
 
 void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, FactorPrecision precision,
-                             const GivenOrdering& given, double min_scaled_entries) {
+                              const GivenOrdering& given, double min_scaled_entries) {
   release();
   cholmod_common* c = &common_->c;
   const int n = s.n_unknowns();
@@ -177,8 +173,10 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
   if (c->status == CHOLMOD_NOT_POSDEF || f->minor < static_cast<size_t>(n)) {
     const auto minor = f->minor;
     release();
-    throw std::domain_error("singular pressure system: the conductance matrix is not positive definite "
-                            "(pivot " + std::to_string(minor) + " of " + std::to_string(n) + ")");
+    throw std::domain_error(
+        "singular pressure system: the conductance matrix is not positive definite "
+        "(pivot " +
+        std::to_string(minor) + " of " + std::to_string(n) + ")");
   }
   if (c->status < CHOLMOD_OK) {
     release();
@@ -298,9 +296,7 @@ void CholmodSolver::solve(const std::vector<double>& rhs, std::vector<double>& x
 #endif
 }
 
-void CholmodSolver::solve_serial(const std::vector<double>& rhs, std::vector<double>& x) {
-  solve_on(rhs, x, false);
-}
+void CholmodSolver::solve_serial(const std::vector<double>& rhs, std::vector<double>& x) { solve_on(rhs, x, false); }
 
 void CholmodSolver::solve_on(const std::vector<double>& rhs, std::vector<double>& x, bool threads) {
   if (!factor_) {

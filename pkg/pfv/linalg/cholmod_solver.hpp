@@ -57,9 +57,8 @@ class CholmodSolver {
   // because the format's error bound assumes it).
   // 'ordering' is computed unless 'given' is accepted.
   // kScaled32 applies to factors of at least min_scaled_entries stored entries (after compaction).
-  void factorize(const PressureSystem& system, Ordering ordering,
-                 FactorPrecision precision = FactorPrecision::kDouble, const GivenOrdering& given = {},
-                 double min_scaled_entries = 0);
+  void factorize(const PressureSystem& system, Ordering ordering, FactorPrecision precision = FactorPrecision::kDouble,
+                 const GivenOrdering& given = {}, double min_scaled_entries = 0);
   // Refactorises in double on the same ordering (no new analysis): for when refinement with
   // the 32-bit factor does not converge (G too ill-conditioned for it).
   void promote_to_double(const PressureSystem& system);
@@ -76,8 +75,8 @@ class CholmodSolver {
   int shared_top_supernodes() const { return parallel_.shared_top_supernodes(); }
   bool metis_used() const { return metis_used_; }
   bool ordering_given() const { return ordering_given_; }  // the given order was kept
-  const int* permutation() const;  // unknown eliminated k-th, after CHOLMOD's postorder
-  double fill() const;             // factor entries per unknown
+  const int* permutation() const;                          // unknown eliminated k-th, after CHOLMOD's postorder
+  double fill() const;                                     // factor entries per unknown
   SupernodalChains chains() const;
   bool ready() const { return factor_ != nullptr; }
   double factor_nonzeros() const;
@@ -108,7 +107,7 @@ class CholmodSolver {
   std::unique_ptr<double[]> values_;
   std::size_t value_capacity_ = 0;
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
-  std::vector<double> scale_;  // per column (elimination order) with kScaled32; empty in double
+  std::vector<double> scale_;          // per column (elimination order) with kScaled32; empty in double
   ParallelSubstitution parallel_;
   bool metis_used_ = false;
   bool ordering_given_ = false;

@@ -42,8 +42,8 @@ SolveStats sweep(const PressureSystem& s, const std::vector<double>& b, std::vec
 
 }  // namespace
 
-SolveStats GaussSeidelSolver::solve(const PressureSystem& system, const std::vector<double>& b,
-                                    std::vector<double>& x, const SolveControl& control) {
+SolveStats GaussSeidelSolver::solve(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
+                                    const SolveControl& control) {
   return sweep(system, b, x, control.tolerance, control.relax, control.max_iterations);
 }
 

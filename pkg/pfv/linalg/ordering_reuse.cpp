@@ -16,7 +16,10 @@ std::array<int, 4> CellOrdering::key_of(const std::array<int, 4>& vertices) {
 
 CellOrdering::CellOrdering(const Mesh& mesh, const PressureSystem& s, const int* perm, SupernodalChains tree,
                            double fresh_fill, bool from_metis)
-    : n_spheres_(mesh.n_spheres), n_(s.n_unknowns()), tree_(std::move(tree)), fresh_fill_(fresh_fill),
+    : n_spheres_(mesh.n_spheres),
+      n_(s.n_unknowns()),
+      tree_(std::move(tree)),
+      fresh_fill_(fresh_fill),
       from_metis_(from_metis) {
   rank_.reserve(static_cast<std::size_t>(n_) * 2);
   for (int k = 0; k < n_; ++k) rank_.emplace(key_of(mesh.cell_vertices[s.unknown_cell[perm[k]]]), k);
@@ -27,7 +30,7 @@ int CellOrdering::common_ancestor(int a, int b) const {
   // Subtrees are ranges ending at their root (postorder), so the ancestor of a that contains
   // b is the first one at or beyond b.
   while (a >= 0 && tree_.chain_end[a] < b) a = tree_.parent[tree_.chain_end[a]];  // up one supernode
-  return a < 0 ? n_ : std::max(a, b);  // different roots: last
+  return a < 0 ? n_ : std::max(a, b);                                             // different roots: last
 }
 
 std::vector<int> CellOrdering::carry_over(const Mesh& mesh, const PressureSystem& s) const {

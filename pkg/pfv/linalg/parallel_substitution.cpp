@@ -68,8 +68,7 @@ inline void subtract_columns(const Stored* block, int nsrow, int j0, int j1, con
 // Columns [j0, j1) of the block's dense triangle, forwards, on u (the block's rows, from row
 // 0): u(j) /= L(j, j), then the rows j+1..j1-1 below it. Leaves u(j) * scale(j) in x.
 template <class Stored>
-inline void solve_triangle(const Stored* block, const double* scale, int nsrow, int j0, int j1, double* u,
-                           double* x) {
+inline void solve_triangle(const Stored* block, const double* scale, int nsrow, int j0, int j1, double* u, double* x) {
   for (int j = j0; j < j1; ++j) {
     const Stored* col = trapezoid_column(block, nsrow, j);
     const double sj = column_scale<Stored>(scale, j);

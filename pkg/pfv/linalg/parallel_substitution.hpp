@@ -62,8 +62,12 @@ class ParallelSubstitution {
   template <class Stored>
   Block<Stored> block(const Stored* values, int s) const {
     const int k1 = L_.super[s];
-    return {k1,     L_.super[s + 1] - k1, L_.pi[s + 1] - L_.pi[s], L_.rows + L_.pi[s] + (L_.super[s + 1] - k1),
-            values + L_.start[s], L_.scale ? L_.scale + k1 : nullptr};
+    return {k1,
+            L_.super[s + 1] - k1,
+            L_.pi[s + 1] - L_.pi[s],
+            L_.rows + L_.pi[s] + (L_.super[s + 1] - k1),
+            values + L_.start[s],
+            L_.scale ? L_.scale + k1 : nullptr};
   }
   // 'thread' is the group (forward, backward) or the thread of the team (shared supernodes);
   // its buffers are acc_[thread], work_[thread] and scaled_[thread].

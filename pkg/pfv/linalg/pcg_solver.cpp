@@ -39,7 +39,7 @@ void PcgSolver::setup(const PressureSystem& s) {
   const int n = s.n_unknowns();
   impl_->ready = false;
   impl_->g = Eigen::Map<const Eigen::SparseMatrix<double>>(n, n, static_cast<Eigen::Index>(s.value.size()),
-                                                          s.col_start.data(), s.row.data(), s.value.data());
+                                                           s.col_start.data(), s.row.data(), s.value.data());
   impl_->cg.compute(impl_->g);
   if (impl_->cg.info() != Eigen::Success)
     throw std::domain_error("incomplete Cholesky preconditioner failed (is the system singular?)");

@@ -71,7 +71,7 @@ double Refinement::estimate_contraction(const PressureSystem& s, CholmodSolver& 
   for (int it = 0; it < kPowerIterations; ++it) {
     for (double& x : v) x /= norm;
     residual(s, zero, v, residual_);  // -G v
-    m.solve(residual_, gv);          // -M^-1 G v
+    m.solve(residual_, gv);           // -M^-1 G v
     for (int i = 0; i < n; ++i) v[i] += gv[i];
     const double next = max_abs(v);
     ratio = next;  // |E v| / |v| with |v| = 1
@@ -81,8 +81,8 @@ double Refinement::estimate_contraction(const PressureSystem& s, CholmodSolver& 
   return ratio;
 }
 
-bool Refinement::solve(const PressureSystem& s, CholmodSolver& m, const std::vector<double>& b,
-                       std::vector<double>& x, double tolerance, int max_passes) {
+bool Refinement::solve(const PressureSystem& s, CholmodSolver& m, const std::vector<double>& b, std::vector<double>& x,
+                       double tolerance, int max_passes) {
   // Corrections this small (relative to x) are round-off: their ratios say nothing about rho.
   constexpr double kRoundOff = 1e-13;
   if (rho_ < 0) rho_ = seed_ > 0 ? seed_ : std::max(kSafety * estimate_contraction(s, m), 1e-12);

@@ -34,8 +34,8 @@ class Refinement {
   // x holds the starting guess on entry. Returns false if the passes stop contracting
   // (rho >= 1/2: G is too ill-conditioned for the rounded factor) or max_passes is reached;
   // x is then unspecified.
-  bool solve(const PressureSystem& system, CholmodSolver& factor, const std::vector<double>& b,
-             std::vector<double>& x, double tolerance, int max_passes);
+  bool solve(const PressureSystem& system, CholmodSolver& factor, const std::vector<double>& b, std::vector<double>& x,
+             double tolerance, int max_passes);
   int passes() const { return passes_; }
   double contraction() const { return rho_; }  // -1 until measured
 

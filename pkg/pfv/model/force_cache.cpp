@@ -25,8 +25,7 @@ void ForceCache::build(const Mesh& mesh, const FacetGeometry& facets, const Pack
     std::array<double, 3> coef;
     for (int s = 0; s < 3; ++s) {
       // Viscous share by wetted area; if no wetted area is known, equal shares to spheres.
-      const double share = wet_sum > 0 ? wet[s] / wet_sum
-                                       : (mesh.is_wall(facets.vertex[f][s]) ? 0.0 : 1.0 / spheres);
+      const double share = wet_sum > 0 ? wet[s] / wet_sum : (mesh.is_wall(facets.vertex[f][s]) ? 0.0 : 1.0 / spheres);
       coef[s] = sector[s] + facets.fluid_area[f] * share;
     }
     for (int side = 0; side < 2; ++side) {

@@ -7,10 +7,8 @@
 
 namespace pfv {
 
-PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets,
-                                        const std::vector<double>& k,
-                                        const BoundaryConditions& bc,
-                                        const std::vector<int>& imposed_cells,
+PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets, const std::vector<double>& k,
+                                        const BoundaryConditions& bc, const std::vector<int>& imposed_cells,
                                         const std::vector<double>& storage) {
   const int nc = mesh.n_cells();
   PressureSystem s;
@@ -75,11 +73,10 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
   const int isolated = static_cast<int>(std::count(reached.begin(), reached.end(), 0));
   if (isolated > 0) {
     const bool none = std::none_of(s.source.begin(), s.source.end(), [](int x) { return x >= 0; });
-    throw std::domain_error(
-        none ? "singular pressure system: no boundary has an imposed pressure (set "
-               "bndCondIsPressure on at least one wall, or imposePressure somewhere)"
-             : "singular pressure system: " + std::to_string(isolated) +
-                   " pore cells are not connected to any imposed pressure");
+    throw std::domain_error(none ? "singular pressure system: no boundary has an imposed pressure (set "
+                                   "bndCondIsPressure on at least one wall, or imposePressure somewhere)"
+                                 : "singular pressure system: " + std::to_string(isolated) +
+                                       " pore cells are not connected to any imposed pressure");
   }
 
   // Upper triangle by column over unknowns.
@@ -139,7 +136,8 @@ void index_rows(PressureSystem& s) {
         s.row_diagonal[j] += s.value[e];
         continue;
       }
-      const std::size_t a = static_cast<std::size_t>(j) * w + count[j]++, b = static_cast<std::size_t>(i) * w + count[i]++;
+      const std::size_t a = static_cast<std::size_t>(j) * w + count[j]++,
+                        b = static_cast<std::size_t>(i) * w + count[i]++;
       s.row_column[a] = i;
       s.row_value[a] = s.value[e];
       s.row_column[b] = j;
@@ -147,8 +145,7 @@ void index_rows(PressureSystem& s) {
     }
 }
 
-void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc,
-                            std::vector<double>& p) {
+void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc, std::vector<double>& p) {
   for (std::size_t c = 0; c < s.source.size(); ++c) {
     const int src = s.source[c];
     if (src < 0) continue;

@@ -15,8 +15,8 @@ namespace pfv {
 
 struct PressureSystem {
   // Per cell.
-  std::vector<int> unknown;  // index among unknowns, -1 for a Dirichlet cell
-  std::vector<int> source;   // Dirichlet source: wall w, or kWallCount + imposed point; else -1
+  std::vector<int> unknown;      // index among unknowns, -1 for a Dirichlet cell
+  std::vector<int> source;       // Dirichlet source: wall w, or kWallCount + imposed point; else -1
   std::vector<double> diagonal;  // sum of k over the cell's throats
   // Cell adjacency through throats, both directions (CSR).
   std::vector<int> adj_start, adj_cell;
@@ -41,10 +41,8 @@ struct PressureSystem {
 
 // imposed_cells[k] is the cell of bc.imposed_pressure[k] (-1 if it lies in no cell).
 // storage (optional, per cell) adds V_i / (K dt) to the diagonal: fluid compressibility.
-PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets,
-                                        const std::vector<double>& k,
-                                        const BoundaryConditions& bc,
-                                        const std::vector<int>& imposed_cells,
+PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets, const std::vector<double>& k,
+                                        const BoundaryConditions& bc, const std::vector<int>& imposed_cells,
                                         const std::vector<double>& storage = {});
 
 // Fills row_width, row_column, row_value and row_diagonal from col_start, row and value
@@ -52,7 +50,6 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
 void index_rows(PressureSystem& s);
 
 // Pressures of the Dirichlet cells from the current boundary values (cheap; every step).
-void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc,
-                            std::vector<double>& pressure);
+void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc, std::vector<double>& pressure);
 
 }  // namespace pfv

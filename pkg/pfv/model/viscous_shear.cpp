@@ -130,14 +130,13 @@ void ViscousShear::accumulate(const Velocity& velocity, int n_spheres, double vi
   for (std::size_t v = 0; v < force.size(); ++v) force[v] += shear[v];
 }
 
-void ViscousShear::add_forces(const std::vector<Vec3>& x, const std::vector<Vec3>& x_prev, double dt,
-                              double viscosity, std::vector<Vec3>& force, std::vector<Vec3>& shear) const {
-  accumulate([&](int k) { return Vec3((x[k] - x_prev[k]) / dt); }, static_cast<int>(x.size()), viscosity, force,
-             shear);
+void ViscousShear::add_forces(const std::vector<Vec3>& x, const std::vector<Vec3>& x_prev, double dt, double viscosity,
+                              std::vector<Vec3>& force, std::vector<Vec3>& shear) const {
+  accumulate([&](int k) { return Vec3((x[k] - x_prev[k]) / dt); }, static_cast<int>(x.size()), viscosity, force, shear);
 }
 
-void ViscousShear::add_velocity_forces(const std::vector<Vec3>& velocity, double viscosity,
-                                       std::vector<Vec3>& force, std::vector<Vec3>& shear) const {
+void ViscousShear::add_velocity_forces(const std::vector<Vec3>& velocity, double viscosity, std::vector<Vec3>& force,
+                                       std::vector<Vec3>& shear) const {
   accumulate([&](int k) { return velocity[k]; }, static_cast<int>(velocity.size()), viscosity, force, shear);
 }
 

@@ -27,15 +27,15 @@ struct ViscousShear {
   std::vector<Vec3> direction;           // unit, from a to b (for a wall: its outward normal)
   std::vector<double> area;              // S_vor
   std::vector<double> hydraulic_radius;  // R_h of the pair; 0 if no fluid around the edge
-  int open_rings = 0;  // edges skipped because a cell around them is not a pore cell
+  int open_rings = 0;                    // edges skipped because a cell around them is not a pore cell
 
   int size() const { return static_cast<int>(a.size()); }
 
   // Adds the shear force on every vertex for sphere velocities (x - x_prev) / dt to 'force'
   // and writes it alone to 'shear' (resized to force.size()). Pairs without fluid (R_h = 0)
   // or with a zero facet (degenerate lattices) take no force.
-  void add_forces(const std::vector<Vec3>& centres, const std::vector<Vec3>& centres_prev, double dt,
-                  double viscosity, std::vector<Vec3>& force, std::vector<Vec3>& shear) const;
+  void add_forces(const std::vector<Vec3>& centres, const std::vector<Vec3>& centres_prev, double dt, double viscosity,
+                  std::vector<Vec3>& force, std::vector<Vec3>& shear) const;
   // The same for given sphere velocities (the linearised operator of the stability limit).
   void add_velocity_forces(const std::vector<Vec3>& velocity, double viscosity, std::vector<Vec3>& force,
                            std::vector<Vec3>& shear) const;

@@ -125,11 +125,14 @@ PYBIND11_MODULE(_core, m) {
   py::class_<YadeForceBridge>(m, "YadeForceBridge")
       .def(py::init<py::object, const py::array_t<long long>&, const py::array_t<long long>&>(),
            py::arg("vector3_type"), py::arg("ids"), py::arg("rows"))
-      .def("apply", [](const YadeForceBridge& b, py::handle add, const FlowEngine& engine) {
-             const std::vector<Vec3>& f = engine.forces();
-             static_assert(sizeof(Vec3) == 3 * sizeof(double), "rows of three doubles");
-             b.apply(add, f.empty() ? nullptr : f.front().data(), f.size());
-           }, py::arg("add"), py::arg("engine"), "The forces of an Engine (its forces(), without the copy).")
+      .def(
+          "apply",
+          [](const YadeForceBridge& b, py::handle add, const FlowEngine& engine) {
+            const std::vector<Vec3>& f = engine.forces();
+            static_assert(sizeof(Vec3) == 3 * sizeof(double), "rows of three doubles");
+            b.apply(add, f.empty() ? nullptr : f.front().data(), f.size());
+          },
+          py::arg("add"), py::arg("engine"), "The forces of an Engine (its forces(), without the copy).")
       .def("apply", py::overload_cast<py::handle, const YadeForceBridge::Forces&>(&YadeForceBridge::apply, py::const_),
            py::arg("add"), py::arg("forces"))
       .def_property_readonly("writes_in_place", &YadeForceBridge::writes_in_place)
@@ -137,7 +140,8 @@ PYBIND11_MODULE(_core, m) {
       .def("__len__", &YadeForceBridge::size);
 
   // The sphere centres from a yade.pack.SpherePack after fromSimulation() (yade_sphere_pack.hpp).
-  m.def("sphere_pack_size", [](py::handle pack) { return sphere_pack_size(pack); }, py::arg("pack"));
+  m.def(
+      "sphere_pack_size", [](py::handle pack) { return sphere_pack_size(pack); }, py::arg("pack"));
   m.def("gather_sphere_pack", &gather_sphere_pack, py::arg("pack"), py::arg("index"), py::arg("centres"),
         py::arg("radii") = py::none(), py::arg("expected_size") = -1);
 
@@ -162,76 +166,105 @@ PYBIND11_MODULE(_core, m) {
       .def(py::init<>())
       // Settings: forwarded as they are; the core validates them (validate()) and decides at
       // the next step what a change makes stale.
-      .def_property("viscosity", [](const FlowEngine& e) { return e.settings.conductance.viscosity; },
-                    [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.viscosity = v; }); })
-      .def_property("permeability_factor", [](const FlowEngine& e) { return e.settings.conductance.permeability_factor; },
-                    [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.permeability_factor = v; }); })
-      .def_property("clamp_k_values", [](const FlowEngine& e) { return e.settings.conductance.clamp; },
-                    [](FlowEngine& e, bool v) { update(e, [&](EngineSettings& s) { s.conductance.clamp = v; }); })
-      .def_property("min_k_div_k_mean", [](const FlowEngine& e) { return e.settings.conductance.min_ratio; },
-                    [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.min_ratio = v; }); })
-      .def_property("max_k_div_k_mean", [](const FlowEngine& e) { return e.settings.conductance.max_ratio; },
-                    [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.max_ratio = v; }); })
-      .def_property("slip_boundary", get_setting(&EngineSettings::slip_boundary), set_setting(&EngineSettings::slip_boundary))
-      .def_property("solver", [](const FlowEngine& e) { return std::string(to_string(e.settings.solver)); },
-                    [](FlowEngine& e, const std::string& v) {
-                      const SolverKind kinds[] = {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient, SolverKind::kCholesky};
-                      for (SolverKind k : kinds)
-                        if (v == to_string(k)) return update(e, [&](EngineSettings& s) { s.solver = k; });
-                      throw py::value_error("solver must be one of gauss_seidel, conjugate_gradient, cholesky");
-                    })
+      .def_property(
+          "viscosity", [](const FlowEngine& e) { return e.settings.conductance.viscosity; },
+          [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.viscosity = v; }); })
+      .def_property(
+          "permeability_factor", [](const FlowEngine& e) { return e.settings.conductance.permeability_factor; },
+          [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.permeability_factor = v; }); })
+      .def_property(
+          "clamp_k_values", [](const FlowEngine& e) { return e.settings.conductance.clamp; },
+          [](FlowEngine& e, bool v) { update(e, [&](EngineSettings& s) { s.conductance.clamp = v; }); })
+      .def_property(
+          "min_k_div_k_mean", [](const FlowEngine& e) { return e.settings.conductance.min_ratio; },
+          [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.min_ratio = v; }); })
+      .def_property(
+          "max_k_div_k_mean", [](const FlowEngine& e) { return e.settings.conductance.max_ratio; },
+          [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.max_ratio = v; }); })
+      .def_property("slip_boundary", get_setting(&EngineSettings::slip_boundary),
+                    set_setting(&EngineSettings::slip_boundary))
+      .def_property(
+          "solver", [](const FlowEngine& e) { return std::string(to_string(e.settings.solver)); },
+          [](FlowEngine& e, const std::string& v) {
+            const SolverKind kinds[] = {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient,
+                                        SolverKind::kCholesky};
+            for (SolverKind k : kinds)
+              if (v == to_string(k)) return update(e, [&](EngineSettings& s) { s.solver = k; });
+            throw py::value_error("solver must be one of gauss_seidel, conjugate_gradient, cholesky");
+          })
       .def_property("tolerance", get_setting(&EngineSettings::tolerance), set_setting(&EngineSettings::tolerance))
       .def_property("relax", get_setting(&EngineSettings::relax), set_setting(&EngineSettings::relax))
-      .def_property("max_iterations", get_setting(&EngineSettings::max_iterations), set_setting(&EngineSettings::max_iterations))
+      .def_property("max_iterations", get_setting(&EngineSettings::max_iterations),
+                    set_setting(&EngineSettings::max_iterations))
       .def_property("force_metis", get_setting(&EngineSettings::force_metis), set_setting(&EngineSettings::force_metis))
-      .def_property("ordering",
-                    [](const FlowEngine& e) {
-                      const char* names[] = {"auto", "amd", "metis", "nesdis"};
-                      return std::string(names[static_cast<int>(e.settings.ordering)]);
-                    },
-                    [](FlowEngine& e, const std::string& v) {
-                      const std::map<std::string, Ordering> names{{"auto", Ordering::kAuto}, {"amd", Ordering::kAmd},
-                                                                  {"metis", Ordering::kMetis}, {"nesdis", Ordering::kNestedDissection}};
-                      const auto it = names.find(v);
-                      if (it == names.end()) throw py::value_error("ordering must be one of auto, amd, metis, nesdis");
-                      update(e, [&](EngineSettings& s) { s.ordering = it->second; });
-                    })
-      .def_property("mixed_precision", get_setting(&EngineSettings::mixed_precision), set_setting(&EngineSettings::mixed_precision))
-      .def_property("mixed_precision_min_entries", get_setting(&EngineSettings::mixed_precision_min_entries), set_setting(&EngineSettings::mixed_precision_min_entries))
-      .def_property("refinement_tolerance", get_setting(&EngineSettings::refinement_tolerance), set_setting(&EngineSettings::refinement_tolerance))
-      .def_property("cholmod_openmp_teams", get_setting(&EngineSettings::cholmod_openmp_teams), set_setting(&EngineSettings::cholmod_openmp_teams))
-      .def_property("reuse_ordering", get_setting(&EngineSettings::reuse_ordering), set_setting(&EngineSettings::reuse_ordering))
+      .def_property(
+          "ordering",
+          [](const FlowEngine& e) {
+            const char* names[] = {"auto", "amd", "metis", "nesdis"};
+            return std::string(names[static_cast<int>(e.settings.ordering)]);
+          },
+          [](FlowEngine& e, const std::string& v) {
+            const std::map<std::string, Ordering> names{{"auto", Ordering::kAuto},
+                                                        {"amd", Ordering::kAmd},
+                                                        {"metis", Ordering::kMetis},
+                                                        {"nesdis", Ordering::kNestedDissection}};
+            const auto it = names.find(v);
+            if (it == names.end()) throw py::value_error("ordering must be one of auto, amd, metis, nesdis");
+            update(e, [&](EngineSettings& s) { s.ordering = it->second; });
+          })
+      .def_property("mixed_precision", get_setting(&EngineSettings::mixed_precision),
+                    set_setting(&EngineSettings::mixed_precision))
+      .def_property("mixed_precision_min_entries", get_setting(&EngineSettings::mixed_precision_min_entries),
+                    set_setting(&EngineSettings::mixed_precision_min_entries))
+      .def_property("refinement_tolerance", get_setting(&EngineSettings::refinement_tolerance),
+                    set_setting(&EngineSettings::refinement_tolerance))
+      .def_property("cholmod_openmp_teams", get_setting(&EngineSettings::cholmod_openmp_teams),
+                    set_setting(&EngineSettings::cholmod_openmp_teams))
+      .def_property("reuse_ordering", get_setting(&EngineSettings::reuse_ordering),
+                    set_setting(&EngineSettings::reuse_ordering))
       .def("ordering_reused", [](const FlowEngine& e) { return e.cholesky() && e.cholmod().ordering_given(); })
       .def("factor_fill", [](const FlowEngine& e) { return e.cholesky() ? e.cholmod().fill() : 0.0; })
-      .def("reduced_precision_factor", [](const FlowEngine& e) { return e.cholesky() && e.cholmod().reduced_precision(); })
+      .def("reduced_precision_factor",
+           [](const FlowEngine& e) { return e.cholesky() && e.cholmod().reduced_precision(); })
       .def("refinement_contraction", &FlowEngine::refinement_contraction)
       .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholesky() ? e.cholmod().factor_nonzeros() : 0.0; })
       .def("factor_flops", [](const FlowEngine& e) { return e.cholesky() ? e.cholmod().factor_flops() : 0.0; })
-      .def_property("fluid_bulk_modulus", get_setting(&EngineSettings::fluid_bulk_modulus), set_setting(&EngineSettings::fluid_bulk_modulus))
-      .def_property("background_remesh", get_setting(&EngineSettings::background_remesh), set_setting(&EngineSettings::background_remesh))
-      .def_property("viscous_shear", get_setting(&EngineSettings::viscous_shear), set_setting(&EngineSettings::viscous_shear),
-                    "Viscous shear between neighbouring spheres (YADE's viscousShear); switching it on remeshes at the next step.")
+      .def_property("fluid_bulk_modulus", get_setting(&EngineSettings::fluid_bulk_modulus),
+                    set_setting(&EngineSettings::fluid_bulk_modulus))
+      .def_property("background_remesh", get_setting(&EngineSettings::background_remesh),
+                    set_setting(&EngineSettings::background_remesh))
+      .def_property("viscous_shear", get_setting(&EngineSettings::viscous_shear),
+                    set_setting(&EngineSettings::viscous_shear),
+                    "Viscous shear between neighbouring spheres (YADE's viscousShear); switching it on remeshes at the "
+                    "next step.")
       .def("remesh_pending", &FlowEngine::remesh_pending)
       .def("wait_for_remesh", &FlowEngine::wait_for_remesh, py::call_guard<py::gil_scoped_release>())
-      .def_property("mesh_update_interval", get_setting(&EngineSettings::mesh_update_interval), set_setting(&EngineSettings::mesh_update_interval))
-      .def_property("def_tolerance", get_setting(&EngineSettings::def_tolerance), set_setting(&EngineSettings::def_tolerance))
+      .def_property("mesh_update_interval", get_setting(&EngineSettings::mesh_update_interval),
+                    set_setting(&EngineSettings::mesh_update_interval))
+      .def_property("def_tolerance", get_setting(&EngineSettings::def_tolerance),
+                    set_setting(&EngineSettings::def_tolerance))
       .def_property("p_zero", get_setting(&EngineSettings::p_zero), set_setting(&EngineSettings::p_zero))
       // Boundary conditions.
-      .def_property("bnd_is_pressure", [](const FlowEngine& e) { return e.bc.is_pressure; },
-                    [](FlowEngine& e, const std::array<bool, 6>& v) { e.bc.is_pressure = v; })
-      .def_property("bnd_value", [](const FlowEngine& e) { return e.bc.value; },
-                    [](FlowEngine& e, const std::array<double, 6>& v) { e.bc.value = v; })
-      .def("impose_pressure", [](FlowEngine& e, const std::array<double, 3>& x, double p) {
+      .def_property(
+          "bnd_is_pressure", [](const FlowEngine& e) { return e.bc.is_pressure; },
+          [](FlowEngine& e, const std::array<bool, 6>& v) { e.bc.is_pressure = v; })
+      .def_property(
+          "bnd_value", [](const FlowEngine& e) { return e.bc.value; },
+          [](FlowEngine& e, const std::array<double, 6>& v) { e.bc.value = v; })
+      .def("impose_pressure",
+           [](FlowEngine& e, const std::array<double, 3>& x, double p) {
              e.bc.imposed_pressure.push_back({Vec3(x[0], x[1], x[2]), p});
              return static_cast<int>(e.bc.imposed_pressure.size()) - 1;
            })
-      .def("set_imposed_pressure", [](FlowEngine& e, int i, double p) {
+      .def("set_imposed_pressure",
+           [](FlowEngine& e, int i, double p) {
              if (i < 0 || i >= static_cast<int>(e.bc.imposed_pressure.size()))
                throw py::index_error("no imposed pressure with index " + std::to_string(i));
              e.bc.imposed_pressure[i].value = p;
            })
       .def("clear_imposed_pressure", [](FlowEngine& e) { e.bc.imposed_pressure.clear(); })
-      .def("impose_flux", [](FlowEngine& e, const std::array<double, 3>& x, double q) {
+      .def("impose_flux",
+           [](FlowEngine& e, const std::array<double, 3>& x, double q) {
              e.bc.imposed_flux.push_back({Vec3(x[0], x[1], x[2]), q});
              return static_cast<int>(e.bc.imposed_flux.size()) - 1;
            })
@@ -242,81 +275,117 @@ PYBIND11_MODULE(_core, m) {
       .def("remesh_due", &FlowEngine::remesh_due)
       .def("has_mesh", &FlowEngine::has_mesh)
       // The step.
-      .def("step", [](FlowEngine& e, const Array& centres, const Array& radii, const std::array<double, 6>& walls, double dt) {
-             auto c = to_points(centres, "positions");
-             auto r = to_vector(radii, "radii");
-             const BoxWalls w = to_walls(walls);
-             py::gil_scoped_release release;
-             e.step(c, r, w, dt);
-           }, py::arg("positions"), py::arg("radii"), py::arg("walls"), py::arg("dt"))
-      .def("viscous_stability_limit", [](const FlowEngine& e, const Array& mass, int iterations) {
-             auto m = to_vector(mass, "masses");
-             py::gil_scoped_release release;
-             return e.viscous_stability_limit(m, iterations);
-           }, py::arg("masses"), py::arg("iterations") = 40)
-      .def("viscous_stability_mode", [](const FlowEngine& e, const Array& mass, int iterations, py::object start) {
-             auto m = to_vector(mass, "masses");
-             std::vector<Vec3> mode;
-             if (!start.is_none()) mode = to_points(start.cast<Array>(), "start");
-             double limit;
-             int applications = 0;
-             {
-               py::gil_scoped_release release;
-               limit = e.viscous_stability_limit(m, iterations, &mode, &applications);
-             }
-             return py::make_tuple(limit, points_to_array(mode), applications);
-           }, py::arg("masses"), py::arg("iterations") = 40, py::arg("start") = py::none(),
-           "(limit, mode, applications): as viscous_stability_limit, by power iteration from `start` (one\n"
-           "velocity per sphere, e.g. the mode returned on the previous mesh) when given, else by Arnoldi; mode is\n"
-           "the estimated eigenvector, applications the operator applications made (each a solve).")
-      .def("forces", [](const FlowEngine& e) { return points_to_array(e.forces()); },
-           "Fluid force on every sphere (input order), then on the six walls.")
-      .def("shear_forces", [](const FlowEngine& e) { return points_to_array(e.shear_forces()); },
-           "The viscous shear part of forces() (empty while viscous_shear is off).")
-      .def("shear_pairs", [](const FlowEngine& e) {
-             const ViscousShear* s = meshed(e).viscous_shear();
-             if (!s) throw py::value_error("viscous_shear is off: the mesh has no shear pairs");
-             py::dict d;
-             d["a"] = vector_to_array(s->a);
-             d["b"] = vector_to_array(s->b);
-             d["direction"] = points_to_array(s->direction);
-             d["area"] = vector_to_array(s->area);
-             d["hydraulic_radius"] = vector_to_array(s->hydraulic_radius);
-             d["open_rings"] = s->open_rings;
-             return d;
-           }, "Pairs of the shear term: vertices a, b (b >= n spheres: wall), unit a->b, S_vor, R_h.")
+      .def(
+          "step",
+          [](FlowEngine& e, const Array& centres, const Array& radii, const std::array<double, 6>& walls, double dt) {
+            auto c = to_points(centres, "positions");
+            auto r = to_vector(radii, "radii");
+            const BoxWalls w = to_walls(walls);
+            py::gil_scoped_release release;
+            e.step(c, r, w, dt);
+          },
+          py::arg("positions"), py::arg("radii"), py::arg("walls"), py::arg("dt"))
+      .def(
+          "viscous_stability_limit",
+          [](const FlowEngine& e, const Array& mass, int iterations) {
+            auto m = to_vector(mass, "masses");
+            py::gil_scoped_release release;
+            return e.viscous_stability_limit(m, iterations);
+          },
+          py::arg("masses"), py::arg("iterations") = 40)
+      .def(
+          "viscous_stability_mode",
+          [](const FlowEngine& e, const Array& mass, int iterations, py::object start) {
+            auto m = to_vector(mass, "masses");
+            std::vector<Vec3> mode;
+            if (!start.is_none()) mode = to_points(start.cast<Array>(), "start");
+            double limit;
+            int applications = 0;
+            {
+              py::gil_scoped_release release;
+              limit = e.viscous_stability_limit(m, iterations, &mode, &applications);
+            }
+            return py::make_tuple(limit, points_to_array(mode), applications);
+          },
+          py::arg("masses"), py::arg("iterations") = 40, py::arg("start") = py::none(),
+          "(limit, mode, applications): as viscous_stability_limit, by power iteration from `start` (one\n"
+          "velocity per sphere, e.g. the mode returned on the previous mesh) when given, else by Arnoldi; mode is\n"
+          "the estimated eigenvector, applications the operator applications made (each a solve).")
+      .def(
+          "forces", [](const FlowEngine& e) { return points_to_array(e.forces()); },
+          "Fluid force on every sphere (input order), then on the six walls.")
+      .def(
+          "shear_forces", [](const FlowEngine& e) { return points_to_array(e.shear_forces()); },
+          "The viscous shear part of forces() (empty while viscous_shear is off).")
+      .def(
+          "shear_pairs",
+          [](const FlowEngine& e) {
+            const ViscousShear* s = meshed(e).viscous_shear();
+            if (!s) throw py::value_error("viscous_shear is off: the mesh has no shear pairs");
+            py::dict d;
+            d["a"] = vector_to_array(s->a);
+            d["b"] = vector_to_array(s->b);
+            d["direction"] = points_to_array(s->direction);
+            d["area"] = vector_to_array(s->area);
+            d["hydraulic_radius"] = vector_to_array(s->hydraulic_radius);
+            d["open_rings"] = s->open_rings;
+            return d;
+          },
+          "Pairs of the shear term: vertices a, b (b >= n spheres: wall), unit a->b, S_vor, R_h.")
       .def("pressure", [](const FlowEngine& e) { return vector_to_array(e.pressure()); })
       // Queries.
       .def("n_cells", [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().n_cells() : 0; })
-      .def("boundary_flux", [](const FlowEngine& e, int w) { check_wall(w); return e.boundary_flux(w); })
+      .def("boundary_flux",
+           [](const FlowEngine& e, int w) {
+             check_wall(w);
+             return e.boundary_flux(w);
+           })
       .def("imposed_flux_total", &FlowEngine::imposed_flux_total)
       .def("volume_rate_total", &FlowEngine::volume_rate_total)
       .def("average_pressure", &FlowEngine::average_pressure)
       .def("average_slice_pressure", &FlowEngine::average_slice_pressure)
-      .def("locate", [](const FlowEngine& e, const std::array<double, 3>& x) { return e.locate(Vec3(x[0], x[1], x[2])); })
-      .def("cell_pressure", [](const FlowEngine& e, int id) { check_cell(e, id); return e.pressure()[id]; })
-      .def("cell_center", [](const FlowEngine& e, int id) {
+      .def("locate",
+           [](const FlowEngine& e, const std::array<double, 3>& x) { return e.locate(Vec3(x[0], x[1], x[2])); })
+      .def("cell_pressure",
+           [](const FlowEngine& e, int id) {
+             check_cell(e, id);
+             return e.pressure()[id];
+           })
+      .def("cell_center",
+           [](const FlowEngine& e, int id) {
              check_cell(e, id);
              const Vec3& c = meshed(e).cells().power_centre[id];
              return std::array<double, 3>{c.x(), c.y(), c.z()};
            })
-      .def("cell_volume", [](const FlowEngine& e, int id) { check_cell(e, id); return meshed(e).cells().volume[id]; })
-      .def("cell_fluid_volume", [](const FlowEngine& e, int id) { check_cell(e, id); return meshed(e).cells().fluid_volume[id]; })
+      .def("cell_volume",
+           [](const FlowEngine& e, int id) {
+             check_cell(e, id);
+             return meshed(e).cells().volume[id];
+           })
+      .def("cell_fluid_volume",
+           [](const FlowEngine& e, int id) {
+             check_cell(e, id);
+             return meshed(e).cells().fluid_volume[id];
+           })
       .def("metis_used", &FlowEngine::metis_used)
-      .def("hidden_spheres", [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; })
+      .def("hidden_spheres",
+           [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; })
       .def_property_readonly("remesh_count", &FlowEngine::remesh_count)
-      .def_property_readonly("sweeps", [](const FlowEngine& e) { return e.last_solve().sweeps; },
-                             "Gauss-Seidel sweeps of the last solve.")
-      .def_property_readonly("cg_iterations", [](const FlowEngine& e) { return e.last_solve().cg_iterations; },
-                             "Conjugate-gradient iterations of the last solve.")
-      .def_property_readonly("refinement_passes", [](const FlowEngine& e) { return e.last_solve().refinement_passes; },
-                             "Refinement passes of the last solve with a 32-bit factor.")
+      .def_property_readonly(
+          "sweeps", [](const FlowEngine& e) { return e.last_solve().sweeps; }, "Gauss-Seidel sweeps of the last solve.")
+      .def_property_readonly(
+          "cg_iterations", [](const FlowEngine& e) { return e.last_solve().cg_iterations; },
+          "Conjugate-gradient iterations of the last solve.")
+      .def_property_readonly(
+          "refinement_passes", [](const FlowEngine& e) { return e.last_solve().refinement_passes; },
+          "Refinement passes of the last solve with a 32-bit factor.")
       .def_property_readonly("accumulated_strain", &FlowEngine::accumulated_strain)
       .def("walls", [](const FlowEngine& e) { return e.walls().coord; })
       .def("remesh_times", [](const FlowEngine& e) { return times_dict(e.remesh_times()); })
       .def("step_times", [](const FlowEngine& e) { return times_dict(e.step_times()); })
       // Geometry, for tests and post-processing.
-      .def("cell_vertices", [](const FlowEngine& e) {
+      .def("cell_vertices",
+           [](const FlowEngine& e) {
              const auto& cv = meshed(e).mesh().cell_vertices;
              py::array_t<int> out({static_cast<py::ssize_t>(cv.size()), py::ssize_t{4}});
              if (!cv.empty()) std::memcpy(out.mutable_data(), cv.data(), cv.size() * sizeof(cv[0]));

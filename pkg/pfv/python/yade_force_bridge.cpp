@@ -1,12 +1,12 @@
 #include "pfv/python/yade_force_bridge.hpp"
 
 #ifdef PFV_HAVE_BOOST_PYTHON
+#include <dlfcn.h>
 #include <Eigen/Core>
+#include <boost/python/errors.hpp>
 #include <boost/python/extract.hpp>
 #include <boost/python/handle.hpp>
-#include <boost/python/errors.hpp>
 #include <boost/python/object.hpp>
-#include <dlfcn.h>
 
 namespace yade {
 class pyForceContainer {};  // only the name matters (Boost.Python's registry)
@@ -39,7 +39,8 @@ double* storage_of(py::handle v) {
 #ifdef PFV_HAVE_BOOST_PYTHON
 // yade::pyForceContainer::force_add(long, Vector3r const&, bool) of yade-double: the Itanium ABI
 // passes `this` first and the Vector3r (three doubles) by address, as ForceAdd declares.
-constexpr const char* kForceAddSymbol = "_ZN4yade16pyForceContainer9force_addElRKN5Eigen6MatrixIdLi3ELi1ELi0ELi3ELi1EEEb";
+constexpr const char* kForceAddSymbol =
+    "_ZN4yade16pyForceContainer9force_addElRKN5Eigen6MatrixIdLi3ELi1ELi0ELi3ELi1EEEb";
 #endif
 
 }  // namespace
@@ -62,8 +63,7 @@ YadeForceBridge::YadeForceBridge(py::object vector3_type, const py::array_t<long
   try {
     const auto path = py::module_::import("yade.wrapper").attr("__file__").cast<std::string>();
     wrapper_module_ = {dlopen(path.c_str(), RTLD_NOW | RTLD_NOLOAD), dlclose};
-    if (wrapper_module_)
-      force_add_ = reinterpret_cast<ForceAdd>(dlsym(wrapper_module_.get(), kForceAddSymbol));
+    if (wrapper_module_) force_add_ = reinterpret_cast<ForceAdd>(dlsym(wrapper_module_.get(), kForceAddSymbol));
   } catch (const std::exception&) {  // no YADE module here, or no file of it: addF calls
     force_add_ = nullptr;
   }

@@ -19,8 +19,7 @@ std::string describe(const Vec3& x) {
   return s.str();
 }
 
-void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                       const BoxWalls& walls) {
+void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls) {
   if (centres.size() != radii.size()) bad_input("positions and radii differ in length");
   if (centres.empty()) bad_input("no spheres to couple with the fluid");
   for (int w = 0; w < kWallCount; ++w)
@@ -30,8 +29,10 @@ void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<doubl
       bad_input("walls " + std::to_string(2 * a) + " and " + std::to_string(2 * a + 1) +
                 " are not in increasing order (min wall at or beyond max wall)");
   for (std::size_t k = 0; k < centres.size(); ++k) {
-    if (!centres[k].allFinite()) bad_input("sphere " + std::to_string(k) + " has a non-finite position " + describe(centres[k]));
-    if (!(std::isfinite(radii[k]) && radii[k] > 0)) bad_input("sphere " + std::to_string(k) + " has a non-positive or non-finite radius");
+    if (!centres[k].allFinite())
+      bad_input("sphere " + std::to_string(k) + " has a non-finite position " + describe(centres[k]));
+    if (!(std::isfinite(radii[k]) && radii[k] > 0))
+      bad_input("sphere " + std::to_string(k) + " has a non-positive or non-finite radius");
     for (int w = 0; w < kWallCount; ++w)
       if (!(walls.height(w, centres[k]) > 0))
         bad_input("sphere " + std::to_string(k) + " centre " + describe(centres[k]) + " is outside wall " +
@@ -43,7 +44,8 @@ void check_distinct_centres(const std::vector<Vec3>& centres) {
   std::vector<int> order(centres.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return std::lexicographical_compare(centres[a].data(), centres[a].data() + 3, centres[b].data(), centres[b].data() + 3);
+    return std::lexicographical_compare(centres[a].data(), centres[a].data() + 3, centres[b].data(),
+                                        centres[b].data() + 3);
   });
   for (std::size_t i = 1; i < order.size(); ++i)
     if (centres[order[i]] == centres[order[i - 1]])

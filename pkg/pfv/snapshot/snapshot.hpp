@@ -10,8 +10,7 @@ namespace pfv {
 
 // Throws std::invalid_argument naming the first problem: sizes, non-finite or non-positive
 // values, walls out of order, a centre on or outside a wall.
-void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                       const BoxWalls& walls);
+void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls);
 
 // Throws std::invalid_argument if two centres coincide (the triangulation would silently
 // drop one sphere).

@@ -159,12 +159,14 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear) {
   else
     has_prev_ = false;  // bodies appeared or vanished: no backward difference this step
   ++remesh_count_;
+  ++system_builds_;
 }
 
 void FlowEngine::rebuild_stale_system(double dt) {
   if (linear_.ready() && !system_rebuild_requested_ && !linear_.recipe.stale_for(settings, bc, dt)) return;
   const auto ordering = linear_.ordering;
   linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver());
+  ++system_builds_;
   system_rebuild_requested_ = false;
 }
 

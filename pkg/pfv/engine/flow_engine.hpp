@@ -93,6 +93,8 @@ class FlowEngine {
   // The current system's Cholesky solver, or nullptr (another solver, or no system yet).
   const CholeskySolver* cholesky() const { return linear_.cholesky(); }
   int remesh_count() const { return remesh_count_; }
+  // Linear systems adopted so far: one per remesh, plus one per rebuild without a remesh.
+  int system_builds() const { return system_builds_; }
   double accumulated_strain() const { return strain_; }
   const SolveStats& last_solve() const { return last_solve_; }
   double refinement_contraction() const;  // -1 until measured, or without a 32-bit factor
@@ -142,6 +144,7 @@ class FlowEngine {
   double strain_ = 0;
   int steps_since_remesh_ = 0;
   int remesh_count_ = 0;
+  int system_builds_ = 0;
   SolveStats last_solve_;
   bool remesh_requested_ = true;
   bool system_rebuild_requested_ = false;

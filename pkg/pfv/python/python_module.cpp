@@ -371,6 +371,7 @@ PYBIND11_MODULE(_core, m) {
       .def("hidden_spheres",
            [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; })
       .def_property_readonly("remesh_count", &FlowEngine::remesh_count)
+      .def_property_readonly("system_builds", &FlowEngine::system_builds)
       .def_property_readonly(
           "sweeps", [](const FlowEngine& e) { return e.last_solve().sweeps; }, "Gauss-Seidel sweeps of the last solve.")
       .def_property_readonly(

@@ -55,8 +55,14 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
       {"mixed_precision_min_entries", [](FlowEngine& e) { e.settings.mixed_precision_min_entries = 0; }},
       {"fluid_bulk_modulus", [](FlowEngine& e) { e.settings.fluid_bulk_modulus = 1e5; }},
       {"bnd_is_pressure", [](FlowEngine& e) { e.bc.is_pressure = {true, true, true, false, false, false}; }},
-      {"impose_pressure", [](FlowEngine& e) { e.bc.imposed_pressure.push_back({Vec3(0.5, 0.5, 0.5), 0.3}); }},
-      {"impose_flux", [](FlowEngine& e) { e.bc.imposed_flux.push_back({Vec3(0.5, 0.5, 0.5), -1e-3}); }},
+      {"impose_pressure",
+       [](FlowEngine& e) {
+         e.bc.imposed_pressure.push_back({Vec3(0.5, 0.5, 0.5), 0.3});
+       }},
+      {"impose_flux",
+       [](FlowEngine& e) {
+         e.bc.imposed_flux.push_back({Vec3(0.5, 0.5, 0.5), -1e-3});
+       }},
       {"bnd_value", [](FlowEngine& e) { e.bc.value = {1.0, 0.5, 0, 0, 0, 0}; }},
       {"tolerance", [](FlowEngine& e) { e.settings.tolerance = 1e-8; }},
       {"relax", [](FlowEngine& e) { e.settings.relax = 1.5; }},

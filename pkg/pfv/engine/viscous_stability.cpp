@@ -2,9 +2,8 @@
 // sphere velocities to fluid forces through the current mesh (flow_engine.hpp).
 //
 // A first mesh has no good starting vector, and power iteration from an arbitrary one creeps:
-// the dense packings measured need 40 iterations, each a solve and a force evaluation (0.46 s
-// of the first step at 10 000 spheres). The Krylov space of those same iterations holds a much
-// better estimate: Arnoldi keeps the iterates orthonormal, and the largest Ritz value of the
+// the dense packings measured need 40 iterations, each a solve and a force evaluation. The Krylov space of those same
+// iterations holds a much better estimate: Arnoldi keeps the iterates orthonormal, and the largest Ritz value of the
 // small Hessenberg matrix converges to the extreme eigenvalue far faster than the power
 // sequence does (thesis-independent textbook fact; Saad, "Numerical methods for large
 // eigenvalue problems", ch. 6). Arnoldi rather than Lanczos because V is only nearly symmetric

@@ -31,9 +31,9 @@ enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
 // Why not float: what limits an approximate factor inside refinement is its perturbation
 // relative to each column, and the entries of a column of L are of similar size. Rounding
 // them to float (24 bits relative to each entry) gives a contraction ||I - M^-1 G|| of
-// 2.5e-7 on the 10 000-sphere benchmark system, 32-bit integers relative to the column's
-// largest entry 1.2e-8 (2.7e-7 and 2e-8 at 50 000), for the same four bytes (doc/model.md,
-// "Solving G p = b"). One pass from the previous step's pressures then meets the default
+// about 20 times the contraction of 32-bit integers relative to the column's largest entry on
+// the benchmark systems, for the same four bytes (doc/solvers.md).
+// One pass from the previous step's pressures then meets the default
 // tolerance; with float it needs two, and a second pass costs what the double solve saves.
 enum class FactorPrecision { kDouble, kScaled32 };
 
@@ -100,10 +100,10 @@ class CholmodSolver {
   bool openmp_teams_ = false;
   void* factor_ = nullptr;  // cholmod_factor*
   // The factor's numeric values, lent to CHOLMOD (which otherwise allocates them afresh at
-  // every factorisation). A factor of 50 000 spheres takes about 480 MB before compaction;
+  // every factorisation). A factor of tens of thousands of spheres takes hundreds of MB;
   // glibc serves blocks that large from new mappings, whose first touch faults in every
-  // 4 KiB page (1.5-20 us each on this VM). Kept across release(), it makes the pages of
-  // one remesh the pages of the next. Only grown, with 1/8 headroom for the next remeshes.
+  // page. Kept across release(), it makes the pages of one remesh the pages of the next. Only grown, with 1/8 headroom
+  // for the next remeshes.
   std::unique_ptr<double[]> values_;
   std::size_t value_capacity_ = 0;
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)

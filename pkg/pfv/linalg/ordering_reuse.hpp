@@ -2,18 +2,14 @@
 //
 // A remesh moves the spheres a little: most pore cells come back with the same four vertices,
 // and the elimination order that METIS found for the old mesh is a good nested dissection of
-// the new one. Finding it afresh is the largest single cost of a remesh (CHOLMOD's analysis:
-// about 0.6 s of a 0.9 s remesh at 10 000 spheres), while carrying it over costs a hash
-// lookup per cell. Cells that survive keep their old position. A new cell (from a flip) is
-// eliminated right after the lowest common ancestor, in the old elimination tree, of its
-// surviving neighbours, as if it had been in the separator that splits them. Measured at
-// 10 000 spheres moved at random by 0.5 % of a radius (0.8 % new cells): 3 % more fill than a
-// fresh METIS ordering, for 1/20 of the analysis time (bench/solver_stages.py). Rejected during
-// development (scratch measurements at 10 000 spheres): following the latest neighbour, which
-// couples subtrees when a flip straddles a separator (2.8x the fill at 2 % of a radius), and
-// placing a new cell as low as the tree allows (20 % more fill at 0.5 %). The caller checks the fill of the
-// result against the fill of the last fresh ordering and orders afresh when it has drifted
-// (cholmod_solver.hpp: GivenOrdering::max_fill).
+// the new one. Finding it afresh is the largest single cost of a remesh (CHOLMOD's analysis),
+// while carrying it over costs a hash lookup per cell. Cells that survive keep their old position. A new cell (from a
+// flip) is eliminated right after the lowest common ancestor, in the old elimination tree, of its surviving neighbours,
+// as if it had been in the separator that splits them: a few per cent more fill than a fresh METIS ordering for a small
+// fraction of the analysis time (bench/solver_stages.py --sections=1; doc/solvers.md). Following the latest neighbour
+// instead couples subtrees when a flip straddles a separator, and placing a new cell as low as the tree allows fills
+// more. The caller checks the fill of the result against the fill of the last fresh ordering and orders afresh when it
+// has drifted (cholmod_solver.hpp: GivenOrdering::max_fill).
 #pragma once
 #include <array>
 #include <cstdint>

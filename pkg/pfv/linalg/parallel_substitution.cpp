@@ -81,12 +81,8 @@ inline void solve_triangle(const Stored* block, const double* scale, int nsrow, 
 // Each sweep reads the factor as one stream (forwards ascending, backwards descending), but
 // in short pieces (most supernodes are a few hundred bytes): the hardware prefetcher restarts
 // on each, and the sweep waits for memory. Asking for the bytes kPrefetchAhead beyond the
-// block being read, in the sweep's direction, keeps the stream going. Development
-// measurements, 10 000 spheres, factor out of cache: forward sweep 5.4 -> 4.0 ms in float and
-// 7.1 -> 5.7 ms in double, together with the four-column rectangle; backward sweep (32-bit
-// factor) 4.7-4.9 -> 3.5-3.6 ms at 10 000 and 36.7 -> 33.8 ms at 50 000, the same from 512 B
-// to 16 KB ahead. (An earlier trial of the backward prefetch, together with a four-column
-// backward sweep, had shown no gain.) doc/benchmarks.md has the project scripts' numbers.
+// block being read, in the sweep's direction, keeps the stream going; the gain hardly depends
+// on the distance between 512 B and 16 KB (bench/solver_stages.py --sections=2).
 constexpr std::ptrdiff_t kPrefetchAhead = 2048;
 
 template <class Stored>

@@ -2,9 +2,9 @@
 // 32-bit integers scaled per column, cholmod_solver.hpp): x <- x + M^-1 (b - G x), the residual
 // in double.
 //
-// The iteration contracts the error by rho = ||I - M^-1 G|| per pass: 1e-8 to 2e-8 on the pore
-// networks measured (10 000 to 50 000 spheres), and it starts from pressures that differ from
-// the new ones by about the change of one DEM step (1e-4 to 4e-4 of their spread): one pass
+// The iteration contracts the error by rho = ||I - M^-1 G|| per pass, of order 1e-8 on pore
+// networks (doc/solvers.md), and it starts from pressures that differ from the new ones by
+// about the change of one DEM step (a small fraction of their spread): one pass
 // meets a tolerance of 1e-10 while it reads half the bytes of a double substitution (plus G
 // once, for the residual). rho is estimated before a factor's first solve by a few power
 // iterations on I - M^-1 G (times a safety factor: the power iteration approaches rho from

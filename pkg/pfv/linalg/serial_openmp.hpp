@@ -3,8 +3,8 @@
 // Debian 12's CHOLMOD 3 is built with CHOLMOD_OMP_NUM_THREADS = 4 and asks for teams of that
 // size in its supernodal numeric factorisation, whatever omp_set_num_threads says. Those teams
 // only copy and scatter small blocks, so on a 2-core machine they cost far more than they
-// save: the factorisation at 10 000 spheres takes 360 ms with them and 157 ms without
-// (bench/solver_stages.py, section 5). Debian's default BLAS (openblas-pthread) keeps its own
+// save: the factorisation takes about twice as long with them (bench/solver_stages.py
+// --sections=5; doc/benchmarks.md). Debian's default BLAS (openblas-pthread) keeps its own
 // threads underneath; an OpenMP build of OpenBLAS would be capped to one thread here too.
 //
 // With dynamic adjustment on and nthreads-var = 1, libgomp caps every region to one thread,

@@ -12,7 +12,7 @@ struct ConductanceModel {
   double viscosity = 1.0;
   double permeability_factor = 1.0;
   // Optional clamping of k to [min_ratio, max_ratio] times the median k (YADE's clampKValues,
-  // minKdivKmean, maxKdivKmean, with a different reference; see doc/yade-differences.md). It
+  // minKdivKmean, maxKdivKmean, with a different reference; see doc/yade.md). It
   // also keeps flat (L = 0) and closed (A_f = 0) throats from making G singular.
   bool clamp = true;
   double min_ratio = 1e-4;

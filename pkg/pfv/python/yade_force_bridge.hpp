@@ -6,7 +6,7 @@
 // the symbol is exported by YADE's wrapper module and found by its mangled name (which spells
 // out the argument types), and the container is the object behind the bound method, found
 // through Boost.Python's converter registry, which YADE's bindings populate. Same function, same
-// arguments as addF, about a fifth of the cost (doc/yade-bridge.md). Failing that (another
+// arguments as addF, about a fifth of the cost (doc/yade.md). Failing that (another
 // YADE, PFV built without Boost.Python), one addF call per body with a YADE Vector3 owned by the
 // bridge and written in place (half the cost of a tuple), or with tuples.
 #pragma once

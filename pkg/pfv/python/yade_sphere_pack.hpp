@@ -1,8 +1,7 @@
 // Reads the sphere centres out of a yade.pack.SpherePack filled by its fromSimulation(): YADE's
 // own C++ loop over the bodies copies (centre, radius) of every sphere, in id order, into the
-// pack's array, which costs 0.28 ms for 10 000 spheres where the three coordinate lists of
-// yade._utils.coordsAndDisplacements cost 1.3 ms (development measurement; doc/yade-bridge.md
-// has the project script's numbers).
+// pack's array, several times faster than building the three coordinate lists of
+// yade._utils.coordsAndDisplacements (bench/solver_stages.py --sections=4; doc/yade.md).
 //
 // Debian's YADE ships no headers, so the pack's array is reached as the Vector3 storage in
 // yade_force_bridge.hpp is: through Boost.Python's converter registry, which YADE's bindings

@@ -21,6 +21,12 @@ double resident_megabytes() {
 }  // namespace
 
 TEST(Memory, FlatOverThousandsOfRemeshes) {
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer keeps freed blocks in its quarantine, resident by design: the resident
+  // size says nothing about the engine's own memory there (the other tests' remeshes still
+  // run under it, and LeakSanitizer checks what is never freed).
+  GTEST_SKIP() << "resident memory is not the engine's under AddressSanitizer";
+#endif
   auto p = test::random_packing(150, 51);
   FlowEngine e;
   e.bc.is_pressure[2] = e.bc.is_pressure[3] = true;

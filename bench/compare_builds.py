@@ -1,0 +1,90 @@
+"""Two builds of pfv side by side on the benchmark permeameter (the cached dense packing of
+bench/flow_benchmark.py, dynamic spheres, CHOLMOD, settled): the steady flow step and a forced
+remesh, measured as the engine's execTime in the DEM loop. For a change that must not alter
+speed (a refactoring), run the build before and the build after; the children alternate
+between the builds round after round, so that drift of the machine falls on both.
+
+    python3 bench/compare_builds.py --builds=OLD_PYTHONPATH,NEW_PYTHONPATH [--size=10000] [--rounds=3]
+                                    [--steady=20] [--remeshes=2] [--threads=1]
+
+Each PYTHONPATH holds a `pfv` package (e.g. build/python). Prints per build the median over
+rounds of the per-round medians, and the ratio of the second build to the first. No timing is
+asserted anywhere.
+"""
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+
+def option(argv, name, default):
+    for a in argv:
+        if a.startswith("--" + name + "="):
+            return a.split("=", 1)[1]
+    return default
+
+
+def child(argv):
+    sys.path.insert(0, os.path.dirname(os.path.abspath(argv[0])))
+    import flow_benchmark as fb
+    from yade import O
+
+    n = int(option(argv, "size", "10000"))
+    if not os.path.exists(fb.packing_path(n)):
+        fb.generate_packing(n)
+    fb.build_scene(n)
+    flow = fb.make_engine("pfv")
+    fb.insert_engine(flow)
+    O.timingEnabled = True
+
+    def timed_step():
+        e0 = flow.execTime
+        O.step()
+        return (flow.execTime - e0) * 1e-9
+
+    for _ in range(3):
+        timed_step()
+    steady = [timed_step() for _ in range(int(option(argv, "steady", "20")))]
+    remesh = []
+    for _ in range(int(option(argv, "remeshes", "2"))):
+        flow.updateTriangulation = True
+        remesh.append(timed_step())
+        for _ in range(2):
+            timed_step()
+    print("RESULT " + json.dumps(dict(steady=statistics.median(steady), remesh=statistics.median(remesh),
+                                      cells=flow.nCells(), package=__import__("pfv").__file__)))
+
+
+def driver(argv):
+    builds = option(argv, "builds", "").split(",")
+    if len(builds) != 2:
+        sys.exit("--builds=OLD,NEW: two PYTHONPATHs")
+    rounds = int(option(argv, "rounds", "3"))
+    threads = option(argv, "threads", "1")
+    passed = [a for a in argv if not a.startswith(("--builds=", "--rounds=", "--threads="))]
+    results = {b: [] for b in builds}
+    for r in range(rounds):
+        for b in (builds if r % 2 == 0 else builds[::-1]):
+            env = dict(os.environ, PYTHONPATH=b, OMP_NUM_THREADS=threads, OPENBLAS_NUM_THREADS=threads)
+            out = subprocess.run(["yade-double", "-j" + threads, "-n", "-x", os.path.abspath(__file__), "--child"]
+                                 + passed, env=env, capture_output=True, text=True)
+            line = [x for x in out.stdout.splitlines() if x.startswith("RESULT ")]
+            if out.returncode != 0 or not line:
+                sys.exit(f"child failed for {b}:\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}")
+            res = json.loads(line[-1][len("RESULT "):])
+            results[b].append(res)
+            print(f"round {r + 1} {b}: steady {res['steady'] * 1e3:.2f} ms, remesh {res['remesh']:.3f} s "
+                  f"({res['cells']} cells, {res['package']})", flush=True)
+    med = {b: {k: statistics.median(x[k] for x in results[b]) for k in ("steady", "remesh")} for b in builds}
+    for b in builds:
+        print(f"{b}: flow step {med[b]['steady'] * 1e3:.2f} ms, remesh {med[b]['remesh']:.3f} s")
+    old, new = builds
+    print(f"ratio second/first: flow step {med[new]['steady'] / med[old]['steady']:.3f}, "
+          f"remesh {med[new]['remesh'] / med[old]['remesh']:.3f}")
+
+
+if "--child" in sys.argv:
+    child(sys.argv)
+else:
+    driver(sys.argv[1:])

@@ -61,8 +61,9 @@ FULL = dict(
 QUICK = dict(num_spheres=1000, viscosity=10.0, load=5.0e3, Tv_end=1.0)
 NONLINEAR_LOAD = 200.0e3   # --nonlinear: thesis 4.4.2
 NONLINEAR_TV_END = 2.0     # --nonlinear runs longer: the final state gives K_final and the coupled final strain
-NONLINEAR_ZETA = 0.5       # --nonlinear: the sample compacts by ~5 %, its conductivity falls by ~30 % and the
-                           # collective viscous limit with it; with zeta = 0.8 both engines blew up near T_v = 1.5
+# --nonlinear: the sample compacts by ~5 %, its conductivity falls by ~30 % and the collective viscous limit
+# with it; with zeta = 0.8 both engines blew up near T_v = 1.5.
+NONLINEAR_ZETA = 0.5
 COMMON = dict(
     box=0.1,               # side of the initial cube [m]
     rRelFuzz=0.2,          # "slightly polydisperse": radii r_mean (1 +- 0.2)
@@ -90,10 +91,11 @@ CACHE_VERSION = 1
 
 # ------------------------------------------------------------------------------------------------------------
 from yade import O, utils, runtime  # noqa: E402
-from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, GlobalStiffnessTimeStepper,  # noqa: E402
-                          Ig2_Box_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                          Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator,
-                          TriaxialStressController, PyRunner, Sphere)
+from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat,  # noqa: E402
+                          GlobalStiffnessTimeStepper, Ig2_Box_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom,
+                          InsertionSortCollider, InteractionLoop, Ip2_FrictMat_FrictMat_FrictPhys,
+                          Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator, TriaxialStressController, PyRunner,
+                          Sphere)
 from yade import pack  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -362,7 +364,8 @@ def prepare(P):
     log('preparing the sample (%d spheres), cached as %s' % (P['num_spheres'], state))
     O.reset()
     L = P['box']
-    O.materials.append(FrictMat(young=P['young'], poisson=P['poisson'], frictionAngle=math.radians(P['compaction_friction']),
+    O.materials.append(FrictMat(young=P['young'], poisson=P['poisson'],
+                                frictionAngle=math.radians(P['compaction_friction']),
                                 density=P['density'], label='spheres'))
     O.materials.append(FrictMat(young=P['young'], poisson=P['poisson'], frictionAngle=0, density=0, label='walls'))
     walls = O.bodies.append(utils.aabbWalls([(0, 0, 0), (L, L, L)], thickness=0, material='walls'))
@@ -590,7 +593,8 @@ def run(opts):
         s = H0 - H
         p_mid = slice_pressure(flow, wall_y(BOTTOM) + 0.5 * H, n)
         row = dict(iter=O.iter - it0, t=t, Tv=t / t_c, height=H, settlement=s, U_sim=s / s_dry,
-                   U_theory=plain.U(t), U_theory_layer=layer.U(t), p_mid=p_mid, p_mid_theory=P['load'] * plain.p(0.5, t),
+                   U_theory=plain.U(t), U_theory_layer=layer.U(t), p_mid=p_mid,
+                   p_mid_theory=P['load'] * plain.p(0.5, t),
                    p_mid_theory_layer=P['load'] * layer.p(0.5, t), sigma_top=top_stress(),
                    sigma_bottom_total=bottom_stress(), bottom_fluid_stress=-flow.fluidForce(BOTTOM)[1] / A,
                    kinetic_energy=utils.kineticEnergy(), drained_volume=drained[0], settlement_volume=s * A)
@@ -610,7 +614,7 @@ def run(opts):
                 % (row['Tv'], row['U_sim'], row['U_theory'], p_mid / P['load'], row['p_mid_theory'] / P['load'],
                    row['sigma_bottom_total']))
     log('engine %s: %d coupled steps in %.1f s (%.2f ms/step)' % (opts['engine'], O.iter - it0, wall_flow,
-                                                                   1e3 * wall_flow / max(1, O.iter - it0)))
+                                                                  1e3 * wall_flow / max(1, O.iter - it0)))
 
     # --- errors --------------------------------------------------------------------------------------------
     def rms(values):
@@ -637,7 +641,8 @@ def run(opts):
                    U_max_abs_error_all=max(abs(r['U_sim'] - r['U_theory']) for r in rows),
                    isochrone_rms_error_all=rms(r['p_over_load'] - r['p_theory_over_load'] for r in iso),
                    max_p_mid_over_load=max(r['p_mid'] for r in rows) / P['load'],
-                   bottom_total_stress_max_error=max(abs(r['sigma_bottom_total'] - load_total) for r in win) / P['load'],
+                   bottom_total_stress_max_error=max(abs(r['sigma_bottom_total'] - load_total)
+                                                     for r in win) / P['load'],
                    drained_over_settlement_volume_end=rows[-1]['drained_volume'] / rows[-1]['settlement_volume'],
                    coupled_wall_seconds=wall_flow, ms_per_step=1e3 * wall_flow / max(1, O.iter - it0))
     if opts['engine'] == 'pfv':
@@ -717,7 +722,7 @@ def plot_runs(runs, path):
     ax[0].semilogx([r['Tv'] for r in first[1]], [r['U_theory_layer'] for r in first[1]], 'k:', lw=1,
                    label='Terzaghi, drained layer of one radius')
     ax[1].semilogx([r['Tv'] for r in first[1]], [r['p_mid_theory_layer'] / first[3]['parameters']['load']
-                                                  for r in first[1]], 'k:', lw=1, label='Terzaghi, drained layer')
+                                                 for r in first[1]], 'k:', lw=1, label='Terzaghi, drained layer')
     for a in ax[:2]:
         a.axvline(first[3]['error_window_Tv_min'], ls='--', color='grey', lw=0.8,
                   label='errors from here (2 wave transits)')
@@ -730,13 +735,15 @@ def plot_runs(runs, path):
                            label='Terzaghi with C_v,final (%s)' % label)
         if 'U_theory_variable_K' in rows[0]:
             ax[0].semilogx([r['Tv'] for r in rows], [r['U_theory_variable_K'] for r in rows], '-.',
-                           label='K falling with the strain (%s, max err %.3f)' % (label, summ['U_max_abs_error_variable_K']))
+                           label='K falling with the strain (%s, max err %.3f)'
+                           % (label, summ['U_max_abs_error_variable_K']))
         ax[1].semilogx([r['Tv'] for r in rows], [r['p_mid'] / summ['parameters']['load'] for r in rows], m, ms=3.5,
                        mfc='none', label='%s (RMS %.3f)' % (label, summ['mid_pressure_rms_error']))
         for j, T in enumerate(sorted(set(r['Tv_target'] for r in iso))):
             pts = [r for r in iso if r['Tv_target'] == T]
             ax[2].plot([r['p_over_load'] for r in pts], [r['z_over_H'] for r in pts], m, ms=3.5, mfc='none',
-                       color='C%d' % j, label=('%s (RMS %.3f)' % (label, summ['isochrone_rms_error'])) if j == 0 else None)
+                       color='C%d' % j,
+                       label=('%s (RMS %.3f)' % (label, summ['isochrone_rms_error'])) if j == 0 else None)
             if k == 0:
                 th = Terzaghi(summ['drainage'], 1.0, 1.0)
                 zz = np.linspace(0, 1, 101)
@@ -759,7 +766,8 @@ def compare(dirs, out):
     for d in dirs:
         with open(os.path.join(d, 'summary.json')) as f:
             s = json.load(f)
-        runs.append((s['engine'], read_csv(os.path.join(d, 'timeseries.csv')), read_csv(os.path.join(d, 'isochrones.csv')), s))
+        runs.append((s['engine'], read_csv(os.path.join(d, 'timeseries.csv')),
+                     read_csv(os.path.join(d, 'isochrones.csv')), s))
         if 'Cv_final' in s:  # recomputed: runs of older versions lack it
             s.update(variable_k_errors(s, runs[-1][1], runs[-1][2]))
     os.makedirs(out, exist_ok=True)
@@ -769,7 +777,9 @@ def compare(dirs, out):
           'whole curve: max abs dU / RMS isochrones | drained / settled volume | ms/step |')
     print('|---|---|---|---|---|---|---|---|---|---|---|---|---|---|')
     for label, rows, iso, s in runs:
-        print('| %s | %.4g | %.4g | %.4g | %d | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f / %.4f | %.4f | %.2f |' % (
+        line_format = ('| %s | %.4g | %.4g | %.4g | %d | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f / %.4f | '
+                       '%.4f | %.2f |')
+        print(line_format % (
             label, s['K'], s['E_oed'], s['Cv'], s['steps'], s['U_max_abs_error'], s['isochrone_rms_error'],
             s['mid_pressure_rms_error'], s['final_U'], s['U_max_abs_error_layer'], s['isochrone_rms_error_layer'],
             s['U_max_abs_error_all'], s['isochrone_rms_error_all'], s['drained_over_settlement_volume_end'],

@@ -1,5 +1,5 @@
 """Costs and semantics of moving data between YADE and a Python-driven engine (measurements for
-doc/yade-bridge.md).
+doc/yade.md).
 
     yade-double -n -x tests/yade/bench_bridge.py [N]        (N spheres, default 10000)
 

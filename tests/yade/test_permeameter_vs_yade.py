@@ -35,7 +35,7 @@ VISCOSITY = 1.0
 TOL_FLUX = 0.05     # relative to YADE's flux
 # No-slip lateral walls: there both engines follow thesis eqs 3.4-3.5. With slip walls (YADE's default)
 # YADE also multiplies R_h of wall throats by 2^(-n/4), which the thesis does not have and which lowers
-# its flux by ~15 % on this scene (doc/yade-differences.md); that case is not a like-for-like comparison.
+# its flux by ~15 % on this scene (doc/yade.md); that case is not a like-for-like comparison.
 SLIP = False
 TOL_PRESSURE = 0.05  # relative to DP
 TOL_FORCE_MEDIAN = 0.10

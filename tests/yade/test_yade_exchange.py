@@ -53,12 +53,12 @@ def run(use_pack):
             O.bodies.erase(victim)
         O.run(1, True)
         steps.append(dict(p=np.array(flow.core.pressure()), f=np.array(flow.core.forces()),
-                          remeshes=flow.core.remesh_count, spheres=len(flow._ids)))
+                          remeshes=flow.core.remesh_count, spheres=len(flow._scan.ids)))
     centres = flow._read_positions()[0]
-    python = np.array([tuple(O.bodies[int(i)].state.pos) for i in flow._ids])
+    python = np.array([tuple(O.bodies[int(i)].state.pos) for i in flow._scan.ids])
     moved = np.abs(python[:ERASE_AT] - start[:ERASE_AT]).max()
     return dict(flow=flow, source=flow.position_source, steps=steps, centres=centres, python=python,
-                moved=moved, ids=list(flow._ids))
+                moved=moved, ids=list(flow._scan.ids))
 
 
 check(_core.sphere_pack_size(SpherePack()) == 0,

@@ -116,7 +116,7 @@ template <class Velocity>
 void ViscousShear::accumulate(const Velocity& velocity, int n_spheres, double viscosity, std::vector<Vec3>& force,
                               std::vector<Vec3>& shear) const {
   // One serial pass: each pair writes two vertices, and the loop costs less than waking threads
-  // would on the sizes measured (doc/model.md).
+  // would on the sizes measured (doc/benchmarks.md).
   shear.assign(force.size(), Vec3::Zero());
   for (int e = 0; e < size(); ++e) {
     const int i = a[e], j = b[e];

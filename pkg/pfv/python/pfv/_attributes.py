@@ -1,0 +1,123 @@
+"""YADE's FlowEngine attribute surface as PFV sees it: the names it implements and those it refuses.
+
+pfv.FlowEngine keeps YADE's attribute names. Most map one to one onto a setting of the C++ core
+under a PEP 8 name (``CORE_NAME``); a few are properties of FlowEngine itself (the six-value
+boundary lists, ``useSolver``, ...), which use the converters below. Every other name YADE's
+FlowEngine has is accepted only at YADE's default value (``check_default``) and reads back as that
+default; YADE methods PFV lacks raise NotImplementedError. Kept apart from the engine so that the
+rules "implemented, refused, misspelt" read in one place, next to the generated name list
+(``_yade_api.py``).
+"""
+from __future__ import annotations
+
+import ast
+from typing import Any, Iterable
+
+from ._yade_api import ATTRIBUTES as _YADE_ATTRIBUTES, METHODS as _YADE_METHODS
+
+# YADE attribute -> attribute of the core (pfv.Engine) that implements it.
+CORE_NAME: dict[str, str] = {
+    "viscosity": "viscosity",
+    "permeabilityFactor": "permeability_factor",
+    "clampKValues": "clamp_k_values",
+    "minKdivKmean": "min_k_div_k_mean",
+    "maxKdivKmean": "max_k_div_k_mean",
+    "slipBoundary": "slip_boundary",
+    "tolerance": "tolerance",
+    "relax": "relax",
+    "forceMetis": "force_metis",
+    "meshUpdateInterval": "mesh_update_interval",
+    "defTolerance": "def_tolerance",
+    "pZero": "p_zero",
+    "multithread": "background_remesh",
+    "fluidBulkModulus": "fluid_bulk_modulus",
+    "viscousShear": "viscous_shear",
+    # PFV extensions (PEP 8 names: YADE has no equivalent).
+    "mixed_precision": "mixed_precision",
+    "mixed_precision_min_entries": "mixed_precision_min_entries",
+    "refinement_tolerance": "refinement_tolerance",
+}
+
+# YADE's useSolver numbers and the core's solver names (YADE's 2, Taucs, has no counterpart).
+_SOLVER_OF_USE_SOLVER: dict[int, str] = {0: "gauss_seidel", 1: "conjugate_gradient", 3: "cholesky"}
+_USE_SOLVER_OF: dict[str, int] = {v: k for k, v in _SOLVER_OF_USE_SOLVER.items()}
+
+
+def is_yade_attribute(name: str) -> bool:
+    """Whether YADE's FlowEngine has an attribute of this name."""
+    return name in _YADE_ATTRIBUTES
+
+
+def is_yade_method(name: str) -> bool:
+    """Whether YADE's FlowEngine has a method of this name."""
+    return name in _YADE_METHODS
+
+
+def default(name: str) -> Any:
+    """YADE's default value of its FlowEngine attribute `name` (its repr when it is no Python literal)."""
+    text = _YADE_ATTRIBUTES[name]
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return text
+
+
+def check_default(name: str, value: Any) -> None:
+    """Accept `value` for the unsupported YADE attribute `name` only if it is YADE's default."""
+    expected = default(name)
+    try:
+        same = value == expected or (isinstance(expected, float) and float(value) == expected)
+    except (TypeError, ValueError):
+        same = False
+    if not same:
+        raise NotImplementedError(
+            f"pfv.FlowEngine does not support YADE FlowEngine attribute '{name}' yet "
+            f"(only its default value {expected!r} is accepted)")
+
+
+def unsupported_method(name: str) -> NotImplementedError:
+    """The error for a YADE FlowEngine method PFV does not implement."""
+    return NotImplementedError(f"pfv.FlowEngine does not support YADE FlowEngine method '{name}' yet")
+
+
+def unknown_attribute(name: str, setting: bool) -> AttributeError:
+    """The error for a name neither PFV nor YADE's FlowEngine has (`setting`: on assignment)."""
+    if setting:
+        return AttributeError(f"pfv.FlowEngine has no attribute '{name}' (and neither has YADE's FlowEngine)")
+    return AttributeError(f"pfv.FlowEngine has no attribute '{name}'")
+
+
+def solver_of_use_solver(value: int) -> str:
+    """The core's solver name for YADE's useSolver number."""
+    if value not in _SOLVER_OF_USE_SOLVER:
+        raise ValueError("useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG, PFV) or 3 (CHOLMOD)")
+    return _SOLVER_OF_USE_SOLVER[value]
+
+
+def use_solver_of(solver: str) -> int:
+    """YADE's useSolver number for the core's solver name."""
+    return _USE_SOLVER_OF[solver]
+
+
+def as_bool6(name: str, value: Iterable[Any]) -> list[bool]:
+    """Six flags, one per wall (xmin, xmax, ymin, ymax, zmin, zmax)."""
+    value = list(value)
+    if len(value) != 6:
+        raise ValueError(f"{name} needs 6 values (xmin, xmax, ymin, ymax, zmin, zmax)")
+    return [bool(v) for v in value]
+
+
+def as_float6(name: str, value: Iterable[Any]) -> list[float]:
+    """Six numbers, one per wall (xmin, xmax, ymin, ymax, zmin, zmax)."""
+    value = [float(v) for v in value]
+    if len(value) != 6:
+        raise ValueError(f"{name} needs 6 values (xmin, xmax, ymin, ymax, zmin, zmax)")
+    return value
+
+
+def as_wall_ids(value: Iterable[Any]) -> list[int]:
+    """Six body ids, one per wall (xmin, xmax, ymin, ymax, zmin, zmax)."""
+    value = [int(v) for v in value]
+    if len(value) != 6:
+        raise ValueError("wallIds needs 6 body ids (xmin, xmax, ymin, ymax, zmin, zmax)")
+    return value

@@ -1,0 +1,188 @@
+"""The scene scan: what pfv.FlowEngine reads of YADE's bodies at each remesh, and the per-step read.
+
+A ``SceneScan`` is made from ``O.bodies`` whenever the bodies or the mesh may have changed. It holds
+the coupled spheres (YADE ids, rows in ``O.bodies``, radii, masses of the dynamic ones), the wall
+bodies (rows and the offset of a box wall's inner face), the map from body id to the core's vertex,
+the DEM time-step limit, the force bridge that adds the fluid forces to YADE's bodies, and the
+position reader chosen for this scene: YADE's SpherePack read in place when it reproduces the
+Python interface exactly, else one coordinate list per axis. Between scans, ``read_positions``
+gives the sphere centres and the six boundary coordinates at every step. Kept apart from the
+engine because it is the only part that knows YADE's body layout.
+"""
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+
+import yade
+from yade.wrapper import Sphere, Box
+from yade.minieigenHP import Vector3
+from yade._packSpheres import SpherePack
+
+from ._core import YadeForceBridge, gather_axis, gather_sphere_pack, sphere_pack_size
+
+_coordinates = yade._utils.coordsAndDisplacements
+
+
+class SceneScan:
+    """Sphere ids, radii, masses and wall bodies of the scene, and how to read their positions.
+
+    `wall_ids` and `use_max_min` are the engine's wallIds and boundaryUseMaxMin; `use_sphere_pack`
+    False always reads the coordinate lists; `warned` collects the one-time warnings of the engine;
+    `previous` is the last scan, whose force bridge and position array are reused when they fit.
+    """
+
+    def __init__(self, wall_ids: Sequence[int], use_max_min: Sequence[bool], *, use_sphere_pack: bool = True,
+                 warned: set[str] | None = None, previous: SceneScan | None = None) -> None:
+        scene = yade.O
+        if scene.periodic:
+            raise NotImplementedError("pfv.FlowEngine does not support periodic scenes yet")
+        self.wall_ids = list(wall_ids)
+        self.outdated = False  # set by the engine when wallIds changes: scan again before use
+        ids, radii, rows, masses, others, clumps = [], [], [], [], 0, 0
+        pack_index, pack_size = [], 0  # SpherePack.fromSimulation() lists every sphere body in id order
+        mass_per_diameter = float("inf")  # min m/d over the dynamic coupled spheres
+        row_of = {}
+        wall_set = set(self.wall_ids)
+        # Each attribute read through Boost.Python makes a new wrapper: read each once per body (the
+        # scan runs at every remesh; bench/flow_benchmark.py times it).
+        for row, b in enumerate(scene.bodies):
+            bid = b.id
+            row_of[bid] = row
+            shape = b.shape
+            is_clump = b.isClump
+            is_sphere = isinstance(shape, Sphere) and not is_clump
+            pack_size += is_sphere
+            if bid in wall_set:
+                continue
+            if is_clump or b.isClumpMember:
+                clumps += 1
+            elif is_sphere:
+                radius = shape.radius
+                pack_index.append(pack_size - 1)
+                ids.append(bid)
+                radii.append(radius)
+                rows.append(row)
+                state = b.state
+                mass = state.mass
+                moving = b.dynamic and mass > 0 and state.blockedDOFs != "xyzXYZ"
+                masses.append(mass if moving else 0.0)
+                if moving:
+                    mass_per_diameter = min(mass_per_diameter, mass / (2 * radius))
+            else:
+                others += 1
+        if clumps:
+            raise NotImplementedError(
+                f"pfv.FlowEngine does not support clumps yet ({clumps} clump bodies or members in the scene)")
+        if warned is None:
+            warned = set()
+        if others and "others" not in warned:
+            warned.add("others")
+            # stacklevel 3: the engine's step, the caller of FlowEngine._rescan.
+            warnings.warn(f"pfv.FlowEngine: {others} bodies that are neither spheres nor the six walls "
+                          "are left out of the flow", stacklevel=3)
+        wall_rows, wall_half = [], []
+        for w, bid in enumerate(self.wall_ids):
+            if bid not in row_of:
+                if not use_max_min[w]:
+                    raise ValueError(f"wallIds[{w}] = {bid} is not a body of the scene")
+                wall_rows.append(-1)
+                wall_half.append(0.0)
+                continue
+            b = scene.bodies[bid]
+            wall_rows.append(row_of[bid])
+            # A box wall bounds the domain with its inner face.
+            half = b.shape.extents[w // 2] if isinstance(b.shape, Box) else 0.0
+            wall_half.append(-half if w % 2 else half)
+        vertex_of_id = {bid: k for k, bid in enumerate(ids)}
+        for w, bid in enumerate(self.wall_ids):
+            vertex_of_id.setdefault(bid, len(ids) + w)
+        self.ids = np.array(ids, dtype=np.int64)          # YADE ids of the coupled spheres
+        self.rows = np.array(rows, dtype=np.int64)        # their rows in O.bodies
+        self.radii = np.array(radii, dtype=float)
+        self.masses = np.array(masses, dtype=float)       # 0 for spheres that do not move
+        self.mass_per_diameter = mass_per_diameter
+        self.wall_rows = wall_rows                        # -1: wall not in the scene
+        self.wall_half = wall_half                        # inner face - centre, along the wall's axis
+        self.n_bodies = len(scene.bodies)
+        self.n_listed = len(row_of)                       # bodies in the coordinate lists
+        self.vertex_of_id = vertex_of_id                  # body id -> row of core.forces()
+        self._bridge_key, self.force_bridge = self._make_force_bridge(ids, wall_rows, previous)
+        dem = yade.utils.PWaveTimeStep() if ids else float("inf")
+        self.dt_dem = dem if dem > 0 else float("inf")
+        self._positions = previous._positions if previous is not None else None
+        self.pack: SpherePack | None = None  # a SpherePack whose array this scan reads, or None
+        self.pack_index: np.ndarray | None = None  # the spheres' places in the pack
+        self.pack_size = 0  # sphere bodies in the pack
+        if use_sphere_pack:
+            self._choose_position_reader(np.array(pack_index, dtype=np.int64), pack_size, use_max_min)
+
+    def _make_force_bridge(self, ids: list[int], wall_rows: list[int],
+                           previous: SceneScan | None) -> tuple[tuple[list[int], list[int]], YadeForceBridge]:
+        """Spheres get force rows 0..n-1, the walls present rows n + w; the previous scan's bridge is
+        kept when it maps the same bodies (its Vector3s are made once)."""
+        bridge_ids = ids + [bid for w, bid in enumerate(self.wall_ids) if wall_rows[w] >= 0]
+        bridge_rows = list(range(len(ids))) + [len(ids) + w for w in range(6) if wall_rows[w] >= 0]
+        key = (bridge_ids, bridge_rows)
+        if previous is not None and previous._bridge_key == key:
+            return key, previous.force_bridge
+        return key, YadeForceBridge(Vector3, np.array(bridge_ids, dtype=np.int64),
+                                    np.array(bridge_rows, dtype=np.int64))
+
+    def _choose_position_reader(self, pack_index: np.ndarray, pack_size: int, use_max_min: Sequence[bool]) -> None:
+        """Read the centres from a SpherePack (yade_sphere_pack.hpp) if this YADE's pack gives,
+        for every sphere, the centre and radius YADE's Python interface gives, bit for bit."""
+        pack = SpherePack()
+        pack.fromSimulation()
+        centres, radii = np.empty((len(pack_index), 3)), np.empty(len(pack_index))
+        if sphere_pack_size(pack) < 0 or not gather_sphere_pack(pack, pack_index, centres, radii, pack_size):
+            return
+        listed = self.read_positions(use_max_min)
+        if listed is not None and np.array_equal(centres, listed[0]) and np.array_equal(radii, self.radii):
+            self.pack_index = pack_index
+            self.pack_size = pack_size
+            self.pack = pack
+
+    @property
+    def position_source(self) -> str:
+        """"SpherePack" or "coordinate lists" (see FlowEngine.position_source)."""
+        return "SpherePack" if self.pack is not None else "coordinate lists"
+
+    def read_positions(self, use_max_min: Sequence[bool]) -> tuple[np.ndarray, list[float]] | None:
+        """Sphere centres (n, 3) and the six boundary coordinates, or None if bodies were erased
+        since the scan. `use_max_min` is boundaryUseMaxMin: a wall's coordinate from the spheres'
+        extent rather than from its body."""
+        pos = self._positions
+        if pos is None or len(pos) != len(self.rows):  # one array per scan, not per step (core.step copies it)
+            pos = np.empty((len(self.rows), 3))
+            self._positions = pos
+        walls = [0.0] * 6
+        if self.pack is not None:
+            pack = self.pack
+            pack.fromSimulation()
+            if not gather_sphere_pack(pack, self.pack_index, pos, None, self.pack_size):
+                return None
+            bodies = yade.O.bodies
+            for w in range(6):
+                if not use_max_min[w]:
+                    wall = bodies[self.wall_ids[w]]
+                    if wall is None:
+                        return None
+                    walls[w] = wall.state.pos[w // 2] + self.wall_half[w]
+        else:
+            for axis in range(3):
+                coords = _coordinates(axis)[0]
+                if len(coords) != self.n_listed:
+                    return None
+                gather_axis(coords, self.rows, pos, axis)
+                for w in (2 * axis, 2 * axis + 1):
+                    if not use_max_min[w]:
+                        walls[w] = coords[self.wall_rows[w]] + self.wall_half[w]
+                del coords  # one list alive at a time
+        for w in range(6):
+            if use_max_min[w]:
+                axis = w // 2
+                walls[w] = float((pos[:, axis] + self.radii).max() if w % 2 else (pos[:, axis] - self.radii).min())
+        return pos, walls

@@ -1,0 +1,93 @@
+"""The time-step guard: is O.dt within the stability limit of the explicit DEM-flow coupling?
+
+The coupling is explicit, so O.dt must stay below ``time_step_safety`` (zeta of thesis 4.22) times
+the smallest of three limits: the single-particle viscous limit dt_MV (thesis 4.20), the collective
+viscous limit of the current mesh (2 / lambda_max(M^-1 V), groups of spheres squeezing shared pores)
+and YADE's DEM P-wave limit. ``TimeStepGuard`` holds what this needs between steps: the collective
+limit and the mesh and viscosity it was computed for, the mode that warm-starts the next
+computation, the history of computations, and whether the step was already reported unsafe (one
+warning on becoming unsafe, not one per step). It knows nothing of YADE: the engine passes it the
+core, the masses and the limits. Kept apart so that the warning logic is readable on its own.
+"""
+from __future__ import annotations
+
+import time
+import warnings
+from typing import Any
+
+import numpy as np
+
+
+class TimeStepWarning(UserWarning):
+    """O.dt exceeds the coupled stability limit (thesis 4.20-4.22)."""
+
+
+def viscous_time_step(mass_per_diameter: float, viscosity: float) -> float:
+    """dt_MV = pi rho d^2 / (1200 mu), written with rho = 6 m / (pi d^3) as m / (200 mu d)."""
+    return mass_per_diameter / (200.0 * viscosity)
+
+
+class TimeStepGuard:
+    """The collective viscous limit of the current mesh and the unsafe-step warning."""
+
+    def __init__(self) -> None:
+        self.safety = 0.8             # O.dt must stay below safety * min(limits)
+        self.strict = False           # raise ValueError instead of warning
+        self.iterations = 40          # operator applications at most, cold start (first mesh)
+        self.iterations_warm = 10     # operator applications at most, warm start (later meshes)
+        self._limit: float | None = None
+        self._computed_for: tuple[float, bool] | None = None  # (viscosity, viscous_shear) of the limit
+        self._mesh: int | None = None  # core.remesh_count the limit was computed on
+        self._mode: np.ndarray | None = None  # its eigenvector, the next mesh's start
+        self._history: list[dict[str, Any]] = []
+        self._unsafe = False
+
+    def mesh_changed(self, core: Any) -> bool:
+        """Whether the core has a mesh the collective limit was not computed on yet."""
+        return self._mesh != core.remesh_count
+
+    def collective_limit(self, core: Any, masses: np.ndarray, iteration: int) -> float:
+        """The collective viscous limit of the core's mesh, computed again on a new mesh or when the
+        viscosity or the shear term changed; `iteration` (O.iter) goes into the history."""
+        if not core.has_mesh():
+            return float("inf")
+        # The shear term adds damping to the operator, so switching it recomputes the limit too
+        # (switched on, its pairs arrive with a remesh, which recomputes again).
+        key = (core.viscosity, core.viscous_shear)
+        if self.mesh_changed(core) or self._computed_for != key:
+            mode = self._mode
+            warm = mode is not None and len(mode) == len(masses) and self._limit is not None
+            iterations = self.iterations_warm if warm else self.iterations
+            t0 = time.perf_counter()
+            limit, mode, applied = core.viscous_stability_mode(masses, iterations, mode if warm else None)
+            seconds = time.perf_counter() - t0
+            self._limit = limit
+            self._mode = mode if len(mode) else None
+            self._computed_for = key
+            self._mesh = core.remesh_count
+            self._history.append(dict(
+                iter=iteration, remesh_count=core.remesh_count, limit=limit, iterations=applied,
+                max_iterations=iterations, warm=warm, seconds=seconds))
+        return self._limit
+
+    @property
+    def history(self) -> list[dict[str, Any]]:
+        """A copy of the list of computations of the collective limit (one dict each)."""
+        return list(self._history)
+
+    def check(self, dt: float, dt_mv: float, dt_collective: float, dt_dem: float) -> None:
+        """Warn (TimeStepWarning) when dt becomes unsafe, or raise ValueError if strict."""
+        limit = self.safety * min(dt_mv, dt_collective, dt_dem)
+        if dt <= limit:
+            self._unsafe = False
+            return
+        message = (f"pfv.FlowEngine: O.dt = {dt:.4g} exceeds the coupled stability limit "
+                   f"{self.safety:g} x min(dt_MV = {dt_mv:.4g}, collective viscous limit = "
+                   f"{dt_collective:.4g}, dt_DEM = {dt_dem:.4g}) = {limit:.4g}; "
+                   f"the explicit coupling may blow up (thesis 4.20-4.22)")
+        if self.strict:
+            raise ValueError(message)
+        if not self._unsafe:  # warn on becoming unsafe, not at every step while it stays so
+            self._unsafe = True
+            # stacklevel 3: the engine's step, the caller of FlowEngine._check_time_step.
+            warnings.warn(message, TimeStepWarning, stacklevel=3)

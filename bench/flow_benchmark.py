@@ -1,4 +1,4 @@
-"""Side-by-side benchmark of YADE's FlowEngine and PFV's FlowEngine (issue 4, measurement part).
+"""Side-by-side benchmark of YADE's FlowEngine and PFV's FlowEngine.
 
 Run with YADE (the driver re-invokes yade-double on this file for every measurement):
 

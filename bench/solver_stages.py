@@ -1,5 +1,4 @@
-"""Stage measurements behind doc/benchmarks.md ("What each optimisation gained", this session's table) and
-doc/model.md ("Solving G p = b"), on the cached benchmark packing (made by bench/flow_benchmark.py).
+"""Stage measurements behind doc/benchmarks.md (stage measurements) and doc/solvers.md, on the cached benchmark packing (made by bench/flow_benchmark.py).
 
     yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6]
 

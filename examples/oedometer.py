@@ -7,7 +7,7 @@
     xvfb-run -a yade-double -x examples/oedometer.py --quick   # the GUI on a virtual display, leaves at the end
     yade-double -n -x examples/oedometer.py --compare=DIR_A,DIR_B [--out=DIR]   # plot two runs together
 
-Thesis section 4.4 (spec ../shared/model-spec.md section 8). The script
+Thesis section 4.4 (Terzaghi consolidation of an oedometer sample). The script
 
 1. prepares a dense packing (particle growth under a TriaxialStressController, then friction raised), switches to
    oedometric conditions (rigid lateral walls, fixed bottom, stress-controlled top wall) and measures the oedometric

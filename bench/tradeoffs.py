@@ -1,4 +1,4 @@
-"""Speed/accuracy study of the PFV engine's options solver, tolerance, remesh schedule.
+"""Speed/accuracy study of the PFV engine's options: solver, tolerance, remesh schedule.
 
     PYTHONPATH=build/python OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 \\
         /usr/bin/python3.11 bench/tradeoffs.py [--quick] [--out=doc/tradeoffs.md] [--jobs=2]

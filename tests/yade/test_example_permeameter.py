@@ -30,7 +30,6 @@ import subprocess
 import sys
 
 
-
 def _here():
     # under `yade-double -x` the script runs in yade's globals: __file__ is /usr/bin/yade-double, sys.argv[0] the script
     if 'yade' in sys.modules and sys.argv and sys.argv[0].endswith('.py'):
@@ -104,18 +103,6 @@ def main():
     failed = sum(not ok for ok, _ in checks)
     print('%d passed, %d failed' % (len(checks) - failed, failed))
     return 1 if failed else 0
-
-
-def test_example_permeameter():
-    """pytest entry: runs this file under yade-double (skipped when yade-double is absent)."""
-    import pytest
-    exe = shutil.which('yade-double')
-    if exe is None:
-        pytest.skip('yade-double not installed')
-    r = subprocess.run([exe, '-n', '-x', os.path.join(HERE, 'test_example_permeameter.py')], capture_output=True,
-                       text=True, timeout=600)
-    print(r.stdout[-6000:])
-    assert r.returncode == 0, 'yade-double exited with %d\n%s\n%s' % (r.returncode, r.stdout[-4000:], r.stderr[-2000:])
 
 
 if __name__ == '__main__' and 'yade' in sys.modules:

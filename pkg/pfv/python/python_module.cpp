@@ -80,14 +80,26 @@ void update(FlowEngine& e, Edit edit) {
   e.settings = s;
 }
 
-// Getter and setter of one top-level setting.
-template <class T>
-auto get_setting(T EngineSettings::*field) {
-  return [field](const FlowEngine& e) { return e.settings.*field; };
+// The settings object that holds fields of type Owner: the engine's settings or their conductance model.
+template <class Settings>
+auto& owner(Settings& s, EngineSettings*) {
+  return s;
 }
-template <class T>
-auto set_setting(T EngineSettings::*field) {
-  return [field](FlowEngine& e, T v) { update(e, [&](EngineSettings& s) { s.*field = v; }); };
+template <class Settings>
+auto& owner(Settings& s, ConductanceModel*) {
+  return s.conductance;
+}
+
+// Getter and setter of one setting.
+template <class T, class Owner>
+auto get_setting(T Owner::*field) {
+  return [field](const FlowEngine& e) { return owner(e.settings, static_cast<Owner*>(nullptr)).*field; };
+}
+template <class T, class Owner>
+auto set_setting(T Owner::*field) {
+  return [field](FlowEngine& e, T v) {
+    update(e, [&](EngineSettings& s) { owner(s, static_cast<Owner*>(nullptr)).*field = v; });
+  };
 }
 
 const FlowEngine& meshed(const FlowEngine& e) {
@@ -166,21 +178,14 @@ PYBIND11_MODULE(_core, m) {
       .def(py::init<>())
       // Settings: forwarded as they are; the core validates them (validate()) and decides at
       // the next step what a change makes stale.
-      .def_property(
-          "viscosity", [](const FlowEngine& e) { return e.settings.conductance.viscosity; },
-          [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.viscosity = v; }); })
-      .def_property(
-          "permeability_factor", [](const FlowEngine& e) { return e.settings.conductance.permeability_factor; },
-          [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.permeability_factor = v; }); })
-      .def_property(
-          "clamp_k_values", [](const FlowEngine& e) { return e.settings.conductance.clamp; },
-          [](FlowEngine& e, bool v) { update(e, [&](EngineSettings& s) { s.conductance.clamp = v; }); })
-      .def_property(
-          "min_k_div_k_mean", [](const FlowEngine& e) { return e.settings.conductance.min_ratio; },
-          [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.min_ratio = v; }); })
-      .def_property(
-          "max_k_div_k_mean", [](const FlowEngine& e) { return e.settings.conductance.max_ratio; },
-          [](FlowEngine& e, double v) { update(e, [&](EngineSettings& s) { s.conductance.max_ratio = v; }); })
+      .def_property("viscosity", get_setting(&ConductanceModel::viscosity), set_setting(&ConductanceModel::viscosity))
+      .def_property("permeability_factor", get_setting(&ConductanceModel::permeability_factor),
+                    set_setting(&ConductanceModel::permeability_factor))
+      .def_property("clamp_k_values", get_setting(&ConductanceModel::clamp), set_setting(&ConductanceModel::clamp))
+      .def_property("min_k_div_k_mean", get_setting(&ConductanceModel::min_ratio),
+                    set_setting(&ConductanceModel::min_ratio))
+      .def_property("max_k_div_k_mean", get_setting(&ConductanceModel::max_ratio),
+                    set_setting(&ConductanceModel::max_ratio))
       .def_property("slip_boundary", get_setting(&EngineSettings::slip_boundary),
                     set_setting(&EngineSettings::slip_boundary))
       .def_property(

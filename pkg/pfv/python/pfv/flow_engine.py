@@ -63,6 +63,12 @@ _INTERNAL = frozenset({
 })
 
 
+def _guard_setting(name: str, doc: str) -> property:
+    """A FlowEngine property that reads and writes the TimeStepGuard's attribute `name`."""
+    return property(lambda self: getattr(self._guard, name), lambda self, value: setattr(self._guard, name, value),
+                    doc=doc)
+
+
 class FlowEngine(PyRunner):
     """PFV's DEM-PFV flow engine with the interface of YADE's FlowEngine."""
 
@@ -175,41 +181,14 @@ class FlowEngine(PyRunner):
         self._threads = int(value) if int(value) > 0 else None
 
     # -- time-step guard settings (held by the TimeStepGuard) --------------------------------
-    @property
-    def time_step_safety(self) -> float:
-        """O.dt must stay below time_step_safety * critical_time_step (zeta of thesis 4.22); 0.8."""
-        return self._guard.safety
-
-    @time_step_safety.setter
-    def time_step_safety(self, value: float) -> None:
-        self._guard.safety = value
-
-    @property
-    def strict_time_step(self) -> bool:
-        """True: an unsafe O.dt raises ValueError instead of warning (TimeStepWarning)."""
-        return self._guard.strict
-
-    @strict_time_step.setter
-    def strict_time_step(self, value: bool) -> None:
-        self._guard.strict = value
-
-    @property
-    def collective_iterations(self) -> int:
-        """Operator applications at most for the collective limit of the first mesh (cold start); 40."""
-        return self._guard.iterations
-
-    @collective_iterations.setter
-    def collective_iterations(self, value: int) -> None:
-        self._guard.iterations = value
-
-    @property
-    def collective_iterations_warm(self) -> int:
-        """Operator applications at most for the collective limit of a later mesh (warm start); 10."""
-        return self._guard.iterations_warm
-
-    @collective_iterations_warm.setter
-    def collective_iterations_warm(self, value: int) -> None:
-        self._guard.iterations_warm = value
+    time_step_safety = _guard_setting(
+        "safety", "O.dt must stay below time_step_safety * critical_time_step (zeta of thesis 4.22); 0.8.")
+    strict_time_step = _guard_setting(
+        "strict", "True: an unsafe O.dt raises ValueError instead of warning (TimeStepWarning).")
+    collective_iterations = _guard_setting(
+        "iterations", "Operator applications at most for the collective limit of the first mesh (cold start); 40.")
+    collective_iterations_warm = _guard_setting(
+        "iterations_warm", "Operator applications at most for the collective limit of a later mesh (warm start); 10.")
 
     # -- the step ---------------------------------------------------------------------------
     def _rescan(self) -> SceneScan:

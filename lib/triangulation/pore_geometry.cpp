@@ -147,16 +147,18 @@ CellShape make_cell_shape(const Mesh& mesh, int cell) {
   return s;
 }
 
-double cell_volume(const CellShape& s, const std::vector<Vec3>& c, const BoxWalls& W) {
+double oriented_cell_volume(const CellShape& s, const std::vector<Vec3>& c, const BoxWalls& W) {
+  // The heights are positive for centres inside the box (validate_snapshot), so the sign comes
+  // from the sphere part alone.
   switch (s.n_walls) {
     case 0: {
       const Vec3& a = c[s.v[0]];
-      return std::abs((c[s.v[1]] - a).dot((c[s.v[2]] - a).cross(c[s.v[3]] - a))) / 6.0;
+      return (c[s.v[1]] - a).dot((c[s.v[2]] - a).cross(c[s.v[3]] - a)) / 6.0;
     }
     case 1: {  // projected triangle times mean height
       const int w = s.v[3];
       const Vec3 &a = c[s.v[0]], &b = c[s.v[1]], &d = c[s.v[2]];
-      const double projected = 0.5 * std::abs((b - a).cross(d - a)[wall_axis(w)]);
+      const double projected = 0.5 * (b - a).cross(d - a)[wall_axis(w)];
       return projected * (W.height(w, a) + W.height(w, b) + W.height(w, d)) / 3.0;
     }
     case 2: {  // segment swept to the wall edge: |ab . e| * integral of h1 h2 along ab
@@ -165,11 +167,11 @@ double cell_volume(const CellShape& s, const std::vector<Vec3>& c, const BoxWall
       const int axis = 3 - wall_axis(w1) - wall_axis(w2);
       const double h1a = W.height(w1, a), h1b = W.height(w1, b);
       const double h2a = W.height(w2, a), h2b = W.height(w2, b);
-      return std::abs(b[axis] - a[axis]) * ((h1a * h2a + h1b * h2b) / 3.0 + (h1a * h2b + h1b * h2a) / 6.0);
+      return (b[axis] - a[axis]) * ((h1a * h2a + h1b * h2b) / 3.0 + (h1a * h2b + h1b * h2a) / 6.0);
     }
     case 3: {
       const Vec3& a = c[s.v[0]];
-      return std::abs(W.height(s.v[1], a) * W.height(s.v[2], a) * W.height(s.v[3], a));
+      return W.height(s.v[1], a) * W.height(s.v[2], a) * W.height(s.v[3], a);
     }
   }
   return 0.0;
@@ -184,9 +186,11 @@ CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& pk) {
   g.power_centre.resize(n);
 #pragma omp parallel for schedule(static) if (n > kMinParallelLoop)
   for (int i = 0; i < n; ++i) {
-    const CellShape s = make_cell_shape(mesh, i);
+    CellShape s = make_cell_shape(mesh, i);
+    const double oriented = oriented_cell_volume(s, pk.centre, pk.walls);
+    s.orientation = static_cast<std::int8_t>((oriented > 0) - (oriented < 0));
     g.shape[i] = s;
-    g.volume[i] = cell_volume(s, pk.centre, pk.walls);
+    g.volume[i] = std::abs(oriented);
     double solid = 0;
     for (int k = 0; k < 4 - s.n_walls; ++k) {
       const auto e = edges_from(s, k, pk);

@@ -11,6 +11,7 @@
 // and wetted areas gamma^k of its three vertices (walls included only for no-slip).
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -23,6 +24,9 @@ namespace pfv {
 // A cell's vertices with spheres first, then walls (as wall indices 0..5).
 struct CellShape {
   std::int8_t n_walls = 0;
+  // The sign of oriented_cell_volume when the mesh was built (0: flat then). Motion that
+  // flips it has turned the cell inside out: the mesh no longer describes the pore space.
+  std::int8_t orientation = 0;
   std::array<int, 4> v{};  // v[0..3-n_walls] sphere ids, the rest wall indices
 };
 
@@ -57,8 +61,13 @@ struct Packing {
 
 CellShape make_cell_shape(const Mesh& mesh, int cell);
 
-// Total volume of a cell for the current positions; this is what dV/dt differentiates.
-double cell_volume(const CellShape& s, const std::vector<Vec3>& centre, const BoxWalls& walls);
+// Total volume of a cell for the current positions, signed by the orientation of its vertices
+// (the sign of the triple product; for wall cells, of the sphere part projected on the wall).
+double oriented_cell_volume(const CellShape& s, const std::vector<Vec3>& centre, const BoxWalls& walls);
+// |oriented_cell_volume|: what dV/dt differentiates.
+inline double cell_volume(const CellShape& s, const std::vector<Vec3>& centre, const BoxWalls& walls) {
+  return std::abs(oriented_cell_volume(s, centre, walls));
+}
 
 CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& packing);
 

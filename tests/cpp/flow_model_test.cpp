@@ -246,14 +246,16 @@ TEST(FlowEngine, FailedBackgroundRemeshSurfacesAndRecovers) {
   e.step(p.centre, p.radius, p.walls, 1.0);
   e.step(p.centre, p.radius, p.walls, 1.0);
   auto bad = p;
-  bad.centre[1] = bad.centre[2];                   // coincident: only the remesh can see it
+  // A radius so large that a neighbour's centre lies inside: only a remesh can see it (the
+  // centres have not moved, so no cell is turned inside out either).
+  bad.radius[1] = 0.5;
   e.step(bad.centre, bad.radius, bad.walls, 1.0);  // launches the background remesh
   e.wait_for_remesh();
   try {
     e.step(p.centre, p.radius, p.walls, 1.0);
     FAIL() << "the background remesh should have failed";
   } catch (const std::invalid_argument& err) {
-    EXPECT_NE(std::string(err.what()).find("coincident"), std::string::npos);
+    EXPECT_NE(std::string(err.what()).find("inside the other sphere"), std::string::npos) << err.what();
   }
   const int before = e.remesh_count();
   e.step(p.centre, p.radius, p.walls, 1.0);  // foreground remesh of the good scene

@@ -1,31 +1,55 @@
 #include "pfv/engine/engine_settings.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 namespace pfv {
 namespace {
 
-void require(bool ok, const char* what) {
+void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
+}
+
+bool finite_positive(double x) { return x > 0 && std::isfinite(x); }
+
+std::string named(const char* name, double value, const char* rule) {
+  char got[32];
+  std::snprintf(got, sizeof got, "%.6g", value);
+  return std::string(name) + " must be " + rule + " (got " + got + ")";
 }
 
 }  // namespace
 
 void validate(const EngineSettings& s) {
   const ConductanceModel& c = s.conductance;
-  require(c.viscosity > 0 && std::isfinite(c.viscosity), "viscosity must be positive and finite");
-  require(c.permeability_factor > 0 && std::isfinite(c.permeability_factor),
-          "permeabilityFactor must be positive (the negative 'homogeneous' variant is not supported)");
+  require(finite_positive(c.viscosity), named("viscosity", c.viscosity, "positive and finite"));
+  require(finite_positive(c.permeability_factor),
+          named("permeabilityFactor", c.permeability_factor,
+                "positive and finite (the negative 'homogeneous' variant is not supported)"));
+  // Checked even while clamping is off: switching it on must not reveal a bad value later.
+  require(finite_positive(c.min_ratio), named("minKdivKmean", c.min_ratio, "positive and finite"));
+  require(finite_positive(c.max_ratio) && c.max_ratio >= c.min_ratio,
+          named("maxKdivKmean", c.max_ratio, "finite and at least minKdivKmean"));
   require(s.solver == SolverKind::kGaussSeidel || s.solver == SolverKind::kConjugateGradient ||
               s.solver == SolverKind::kCholesky,
           "solver must be Gauss-Seidel, conjugate gradients or Cholesky");
-  require(s.relax > 0 && s.relax < 2, "relax must be in (0, 2)");
+  // A tolerance of zero never stops Gauss-Seidel and NaN stops conjugate gradients at once.
+  require(finite_positive(s.tolerance) && s.tolerance < 1, named("tolerance", s.tolerance, "in (0, 1)"));
+  require(s.relax > 0 && s.relax < 2, named("relax", s.relax, "in (0, 2)"));
+  require(s.max_iterations > 0, named("max_iterations", s.max_iterations, "positive"));
+  require(std::isfinite(s.max_fill_growth) && s.max_fill_growth >= 1,
+          named("max_fill_growth", s.max_fill_growth, "finite and at least 1"));
   require(s.mixed_precision_min_entries >= 0 && std::isfinite(s.mixed_precision_min_entries),
-          "mixed_precision_min_entries must be finite and >= 0");
-  require(s.refinement_tolerance > 0 && s.refinement_tolerance < 1, "refinement_tolerance must be in (0, 1)");
-  require(s.fluid_bulk_modulus >= 0 && std::isfinite(s.fluid_bulk_modulus), "fluidBulkModulus must be >= 0 and finite");
+          named("mixed_precision_min_entries", s.mixed_precision_min_entries, "finite and >= 0"));
+  require(s.refinement_tolerance > 0 && s.refinement_tolerance < 1,
+          named("refinement_tolerance", s.refinement_tolerance, "in (0, 1)"));
+  require(s.max_refinement_passes > 0, named("max_refinement_passes", s.max_refinement_passes, "positive"));
+  require(std::isfinite(s.def_tolerance), named("defTolerance", s.def_tolerance, "finite"));
+  require(std::isfinite(s.p_zero), named("pZero", s.p_zero, "finite"));
+  require(s.fluid_bulk_modulus >= 0 && std::isfinite(s.fluid_bulk_modulus),
+          named("fluidBulkModulus", s.fluid_bulk_modulus, ">= 0 and finite"));
 }
 
 }  // namespace pfv

@@ -13,9 +13,30 @@
 #include "pfv/snapshot/snapshot.hpp"
 
 namespace pfv {
+namespace {
+
+constexpr double kInversionFraction = 1e-3;  // of the mean cell volume (assemble)
+
+}  // namespace
 
 FlowEngine::~FlowEngine() {
   if (pending_) pending_->result.wait();  // the worker reads copies only, but let it finish
+}
+
+void FlowEngine::release() {
+  if (pending_) pending_->result.wait();
+  pending_.reset();
+  mesh_.reset();
+  linear_ = LinearSystem{};
+  for (auto* v : {&pressure_, &volume_, &volume_rate_, &rhs_, &solution_, &next_volume_, &next_pressure_,
+                  &pressure_before_})
+    std::vector<double>().swap(*v);
+  for (auto* v : {&force_, &next_force_, &shear_force_, &next_shear_, &centres_prev_}) std::vector<Vec3>().swap(*v);
+  has_prev_ = keep_trend_ = false;
+  strain_ = 0;
+  steps_since_remesh_ = 0;
+  remesh_requested_ = true;
+  last_solve_ = SolveStats{};
 }
 
 bool FlowEngine::remesh_due() const {
@@ -48,7 +69,15 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   rebuild_stale_system(dt);
   // From here on everything writes into scratch buffers; the engine's state changes only in
   // commit(), once the step has produced finite pressures and forces.
-  const double strain = assemble(centres, walls, dt);
+  double strain = assemble(centres, walls, dt);
+  if (inverted_cells_ > 0) {
+    // Spheres moved so far since the remesh that cells turned inside out: their volumes and
+    // throats mean nothing any more (fluxes of the wrong sign). Remesh at these positions,
+    // whatever the schedule says.
+    remesh_now(centres, radii, walls, dt);
+    ++inversion_remeshes_;
+    strain = assemble(centres, walls, dt);
+  }
   solve();
   compute_forces(centres, dt);
   commit(centres, walls, strain);
@@ -59,6 +88,7 @@ void FlowEngine::validate_step(const std::vector<Vec3>& centres, const std::vect
                                const BoxWalls& walls, double dt) const {
   if (!(dt > 0 && std::isfinite(dt))) throw std::invalid_argument("time step must be positive and finite");
   validate(settings);
+  validate(bc);
   validate_snapshot(centres, radii, walls);
 }
 
@@ -109,6 +139,10 @@ void FlowEngine::remesh_in_background(const std::vector<Vec3>& centres, const st
 
 void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                             double dt) {
+  if (pending_) {  // superseded by this one
+    pending_->result.wait();
+    pending_.reset();
+  }
   PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
   // Free the old factor first (the largest object: peak memory is then one factor, not two).
   // Should the new system fail, the old mesh is kept without a solver and the next step starts
@@ -163,6 +197,9 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear) {
 }
 
 void FlowEngine::rebuild_stale_system(double dt) {
+  // A new viscosity applies at once: the conductances are rescaled (no new triangulation), the
+  // system is then stale (its recipe records the viscosity).
+  if (mesh_->viscosity() != settings.conductance.viscosity) mesh_->set_viscosity(settings.conductance.viscosity);
   if (linear_.ready() && !system_rebuild_requested_ && !linear_.recipe.stale_for(settings, bc, dt)) return;
   const auto ordering = linear_.ordering;
   linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver());
@@ -176,16 +213,25 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   // Pore strain of the step, max over cells (thesis 5.13). A near-flat cell would make any
   // motion look like a huge strain, so volumes below the mean count as the mean.
   double max_change = 0;
+  // A cell counts as turned inside out once its flipped volume exceeds a small part of the mean:
+  // the slivers of a dense packing (volumes far below the mean) flip under any small motion,
+  // harmlessly, and must not force remeshes.
+  const double inside_out = -kInversionFraction * mesh_->mean_cell_volume;
+  int inverted_cells = 0;
   next_volume_.resize(nc);
   volume_rate_.resize(nc);
-#pragma omp parallel for schedule(static) reduction(max : max_change) if (nc > kMinParallelLoop)
+#pragma omp parallel for schedule(static) reduction(max : max_change) reduction(+ : inverted_cells) if (nc > kMinParallelLoop)
   for (int c = 0; c < nc; ++c) {
-    const double v = cell_volume(mesh_->cells.shape[c], centres, walls);
+    const CellShape& shape = mesh_->cells.shape[c];
+    const double oriented = oriented_cell_volume(shape, centres, walls);
+    inverted_cells += shape.orientation * oriented < inside_out;
+    const double v = std::abs(oriented);
     const double dv = has_prev_ ? v - volume_[c] : 0.0;
     volume_rate_[c] = dv / dt;
     max_change = std::max(max_change, std::abs(dv) / std::max(v, mesh_->mean_cell_volume));
     next_volume_[c] = v;
   }
+  inverted_cells_ = inverted_cells;
   step_times_.volumes = seconds_since(t0);
 
   // b = -dV/dt (+ V_f/(K dt) p^n, implicit Euler on the stored fluid) + imposed fluxes + the

@@ -39,6 +39,9 @@ class FlowEngine {
   // Forget the previous positions: the next step has no dV/dt term. For when the boundary
   // is redefined (a moved fictitious wall is not a change of pore volume).
   void reset_history() { has_prev_ = false; }
+  // Free the mesh, the system and every per-cell result (keeping the settings and boundary
+  // conditions): for an engine taken out of use. A later step starts afresh with a remesh.
+  void release();
   bool remesh_due() const;
   bool remesh_pending() const { return pending_.has_value(); }
   // Blocks until a background remesh in flight has finished; the next step adopts it.
@@ -46,6 +49,9 @@ class FlowEngine {
     if (pending_) pending_->result.wait();
   }
   bool has_mesh() const { return mesh_ != nullptr; }
+  // The viscosity of the current mesh's conductances: settings.conductance.viscosity once a step
+  // has run since it changed.
+  double mesh_viscosity() const { return mesh_ ? mesh_->viscosity() : settings.conductance.viscosity; }
 
   // Stability limit of the explicit coupling from the fluid alone: 2 / lambda_max of
   // M^-1 V, where V maps sphere velocities to fluid forces through the current mesh
@@ -93,6 +99,9 @@ class FlowEngine {
   // The current system's Cholesky solver, or nullptr (another solver, or no system yet).
   const CholeskySolver* cholesky() const { return linear_.cholesky(); }
   int remesh_count() const { return remesh_count_; }
+  // Remeshes forced because the spheres had turned cells inside out since the last remesh
+  // (motion too large for the remesh schedule); each also counts in remesh_count().
+  int inversion_remeshes() const { return inversion_remeshes_; }
   // Linear systems adopted so far: one per remesh, plus one per rebuild without a remesh.
   int system_builds() const { return system_builds_; }
   double accumulated_strain() const { return strain_; }
@@ -144,6 +153,8 @@ class FlowEngine {
   double strain_ = 0;
   int steps_since_remesh_ = 0;
   int remesh_count_ = 0;
+  int inverted_cells_ = 0;  // of the last assemble()
+  int inversion_remeshes_ = 0;
   int system_builds_ = 0;
   SolveStats last_solve_;
   bool remesh_requested_ = true;

@@ -1,9 +1,13 @@
 #include "pfv/engine/linear_system.hpp"
 
+#include <stdexcept>
+#include <string>
+
 #include "pfv/common/stage_timer.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/linalg/gauss_seidel_solver.hpp"
 #include "pfv/linalg/pcg_solver.hpp"
+#include "pfv/snapshot/snapshot.hpp"
 
 namespace pfv {
 namespace {
@@ -13,6 +17,21 @@ std::vector<Vec3> positions(const std::vector<PointCondition>& conditions) {
   x.reserve(conditions.size());
   for (const auto& c : conditions) x.push_back(c.position);
   return x;
+}
+
+// The cell of each point; a point in no pore cell would be a condition silently dropped.
+std::vector<int> locate_points(const PoreMesh& m, const std::vector<PointCondition>& conditions, const char* what) {
+  std::vector<int> cells;
+  cells.reserve(conditions.size());
+  for (std::size_t i = 0; i < conditions.size(); ++i) {
+    const int c = m.tri.locate(conditions[i].position);
+    if (c < 0)
+      throw std::invalid_argument(std::string(what) + " " + std::to_string(i) + " at " +
+                                  describe(conditions[i].position) +
+                                  " lies in no pore cell (outside the walls or the packing)");
+    cells.push_back(c);
+  }
+  return cells;
 }
 
 std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
@@ -31,6 +50,7 @@ std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
 
 SystemRecipe::SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc, double step)
     : solver(s.solver),
+      viscosity(s.conductance.viscosity),
       ordering(s.factor_ordering()),
       mixed_precision(s.mixed_precision),
       mixed_precision_min_entries(s.mixed_precision_min_entries),
@@ -41,7 +61,9 @@ SystemRecipe::SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc
       imposed_flux_at(positions(bc.imposed_flux)) {}
 
 bool SystemRecipe::stale_for(const EngineSettings& s, const BoundaryConditions& bc, double step) const {
-  if (solver != s.solver || fluid_bulk_modulus != s.fluid_bulk_modulus || is_pressure != bc.is_pressure) return true;
+  if (solver != s.solver || viscosity != s.conductance.viscosity || fluid_bulk_modulus != s.fluid_bulk_modulus ||
+      is_pressure != bc.is_pressure)
+    return true;
   if (fluid_bulk_modulus > 0 && dt != step) return true;
   if (solver == SolverKind::kCholesky && (ordering != s.factor_ordering() || mixed_precision != s.mixed_precision ||
                                           mixed_precision_min_entries != s.mixed_precision_min_entries))
@@ -68,8 +90,8 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
     for (int c = 0; c < m.mesh().n_cells(); ++c)
       l.storage[c] = m.cells.fluid_volume[c] / (settings.fluid_bulk_modulus * dt);
   }
-  for (const auto& c : bc.imposed_pressure) l.imposed_pressure_cells.push_back(m.tri.locate(c.position));
-  for (const auto& c : bc.imposed_flux) l.imposed_flux_cells.push_back(m.tri.locate(c.position));
+  l.imposed_pressure_cells = locate_points(m, bc.imposed_pressure, "imposed pressure");
+  l.imposed_flux_cells = locate_points(m, bc.imposed_flux, "imposed flux");
 
   auto t0 = StageClock::now();
   l.system = assemble_pressure_system(m.mesh(), m.facets, m.k, bc, l.imposed_pressure_cells, l.storage);

@@ -22,6 +22,7 @@ class CholeskySolver;
 // The settings and boundary conditions a linear system depends on.
 struct SystemRecipe {
   SolverKind solver = SolverKind::kCholesky;
+  double viscosity = 0;                 // of the conductances in G
   Ordering ordering = Ordering::kAuto;  // Cholesky only
   bool mixed_precision = false;         // Cholesky only
   double mixed_precision_min_entries = 0;
@@ -54,7 +55,8 @@ struct LinearSystem {
   CholeskySolver* cholesky();
 };
 
-// Throws std::domain_error if the system is singular. previous: the ordering of the last
+// Throws std::domain_error if the system is singular, std::invalid_argument if an imposed point
+// lies in no pore cell. previous: the ordering of the last
 // factorisation, tried first when settings.reuse_ordering (null: compute one). recycled: the
 // released solver of the previous system, reused (with the storage of its factor's values) if
 // it is of the kind the settings ask for.

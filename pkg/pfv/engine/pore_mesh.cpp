@@ -16,6 +16,12 @@ bool MeshRecipe::stale_for(const EngineSettings& s) const {
          a.max_ratio != b.max_ratio || slip_boundary != s.slip_boundary || (s.viscous_shear && !viscous_shear);
 }
 
+void PoreMesh::set_viscosity(double mu) {
+  const double scale = recipe.conductance.viscosity / mu;
+  for (double& x : k) x *= scale;
+  recipe.conductance.viscosity = mu;
+}
+
 PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                          const EngineSettings& settings) {
   check_distinct_centres(centres);

@@ -24,8 +24,10 @@ struct MeshRecipe {
   explicit MeshRecipe(const EngineSettings& s)
       : conductance(s.conductance), slip_boundary(s.slip_boundary), viscous_shear(s.viscous_shear) {}
   // Whether a mesh built from this recipe must be rebuilt for 's'. The viscosity is not
-  // compared: a change applies from the next remesh (as in YADE). Switching viscous_shear off
-  // needs no remesh: the engine drops the pairs and clears viscous_shear here.
+  // compared: every conductance is inversely proportional to it (the clamp is relative to the
+  // median), so a change rescales them (PoreMesh::set_viscosity) without a new triangulation.
+  // Switching viscous_shear off needs no remesh: the engine drops the pairs and clears
+  // viscous_shear here.
   bool stale_for(const EngineSettings& s) const;
 };
 
@@ -42,6 +44,9 @@ struct PoreMesh {
 
   explicit PoreMesh(const EngineSettings& s) : recipe(s) {}
   const Mesh& mesh() const { return tri.mesh(); }
+  double viscosity() const { return recipe.conductance.viscosity; }
+  // The conductances for another viscosity: k scales as 1 / mu.
+  void set_viscosity(double mu);
 };
 
 // Throws std::invalid_argument for coincident centres or a centre inside another sphere.

@@ -66,9 +66,14 @@ void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const s
 double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode,
                                            int* applications) const {
   if (applications) *applications = 0;
-  if (!has_mesh() || !has_prev_) throw std::logic_error("the stability limit needs a mesh: run a step first");
+  // Linearised about the positions of the last step, which the mesh holds once a step on it has
+  // succeeded (a forgotten history, reset_history(), does not matter here).
+  if (!has_mesh() || centres_prev_.size() != static_cast<std::size_t>(mesh().n_spheres))
+    throw std::logic_error("the stability limit needs a mesh: run a step first");
   const int n = mesh().n_spheres;
-  if (static_cast<int>(mass.size()) != n) throw std::invalid_argument("one mass per sphere is needed");
+  if (static_cast<int>(mass.size()) != n)
+    throw std::invalid_argument("one mass per sphere of the mesh is needed (" + std::to_string(n) + " spheres, " +
+                                std::to_string(mass.size()) + " masses)");
   for (int k = 0; k < n; ++k)
     if (!std::isfinite(mass[k])) throw std::invalid_argument("mass of sphere " + std::to_string(k) + " is not finite");
   const int nu = linear_.system.n_unknowns();

@@ -20,4 +20,9 @@ struct BoundaryConditions {
   std::vector<PointCondition> imposed_flux;
 };
 
+// Throws std::invalid_argument naming the first non-finite boundary value, imposed point or
+// imposed value. Whether an imposed point lies in the pore space is known only on a mesh
+// (build_linear_system checks it there).
+void validate(const BoundaryConditions& bc);
+
 }  // namespace pfv

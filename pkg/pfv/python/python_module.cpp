@@ -4,8 +4,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstring>
 #include <map>
+#include <mutex>
 #include <string>
 #ifdef _OPENMP
 #include <omp.h>
@@ -15,6 +17,7 @@
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/python/yade_force_bridge.hpp"
 #include "pfv/python/yade_sphere_pack.hpp"
+#include "pfv/snapshot/snapshot.hpp"
 
 namespace py = pybind11;
 using namespace pfv;
@@ -71,6 +74,51 @@ py::dict times_dict(const StageTimes& t) {
   return d;
 }
 
+// The engine as Python holds it. YADE runs O.run() on a thread of its own, so a query from the
+// main thread may arrive while a step rebuilds the mesh. Every call into the engine takes its
+// lock; a caller that must wait does so with the GIL released (a step releases the GIL while it
+// runs, and never needs it while it holds the lock), so the two threads cannot deadlock.
+struct SharedEngine : FlowEngine {
+  mutable std::mutex busy;
+};
+
+std::unique_lock<std::mutex> hold(const SharedEngine& e) {
+  std::unique_lock<std::mutex> lock(e.busy, std::try_to_lock);
+  if (!lock.owns_lock()) {
+    py::gil_scoped_release release;
+    lock.lock();
+  }
+  return lock;
+}
+
+// f(engine, args...) under the engine's lock, for a lambda taking the engine first ...
+template <class F, class R, class Self, class... A>
+auto exclusive_call(F f, R (F::*)(Self, A...) const) {
+  return [f = std::move(f)](Self e, A... a) -> R {
+    const auto lock = hold(e);
+    return f(e, std::forward<A>(a)...);
+  };
+}
+template <class F>
+auto exclusive(F f) {
+  return exclusive_call(std::move(f), &F::operator());
+}
+// ... or for a member function of the engine.
+template <class R, class... A>
+auto exclusive(R (FlowEngine::*m)(A...) const) {
+  return [m](const SharedEngine& e, A... a) -> R {
+    const auto lock = hold(e);
+    return (e.*m)(std::forward<A>(a)...);
+  };
+}
+template <class R, class... A>
+auto exclusive(R (FlowEngine::*m)(A...)) {
+  return [m](SharedEngine& e, A... a) -> R {
+    const auto lock = hold(e);
+    return (e.*m)(std::forward<A>(a)...);
+  };
+}
+
 // Applies an edit to a copy of the settings, validated by the core before it is kept.
 template <class Edit>
 void update(FlowEngine& e, Edit edit) {
@@ -93,13 +141,31 @@ auto& owner(Settings& s, ConductanceModel*) {
 // Getter and setter of one setting.
 template <class T, class Owner>
 auto get_setting(T Owner::*field) {
-  return [field](const FlowEngine& e) { return owner(e.settings, static_cast<Owner*>(nullptr)).*field; };
+  return exclusive([field](const SharedEngine& e) { return owner(e.settings, static_cast<Owner*>(nullptr)).*field; });
 }
 template <class T, class Owner>
 auto set_setting(T Owner::*field) {
-  return [field](FlowEngine& e, T v) {
+  return exclusive([field](SharedEngine& e, T v) {
     update(e, [&](EngineSettings& s) { owner(s, static_cast<Owner*>(nullptr)).*field = v; });
-  };
+  });
+}
+
+// Appends a point condition (YADE's imposePressure, imposeFlux) and returns its index. Refused
+// if not finite, or, on a mesh, if it lies in no pore cell (a later remesh checks again).
+int add_point_condition(FlowEngine& e, std::vector<PointCondition>& list, const PointCondition& c) {
+  list.push_back(c);
+  try {
+    validate(e.bc);
+  } catch (...) {
+    list.pop_back();
+    throw;
+  }
+  if (e.has_mesh() && e.locate(c.position) < 0) {
+    list.pop_back();
+    throw py::value_error("the point " + describe(c.position) +
+                          " lies in no pore cell (outside the walls or the packing)");
+  }
+  return static_cast<int>(list.size()) - 1;
 }
 
 const FlowEngine& meshed(const FlowEngine& e) {
@@ -139,7 +205,8 @@ PYBIND11_MODULE(_core, m) {
            py::arg("vector3_type"), py::arg("ids"), py::arg("rows"))
       .def(
           "apply",
-          [](const YadeForceBridge& b, py::handle add, const FlowEngine& engine) {
+          [](const YadeForceBridge& b, py::handle add, const SharedEngine& engine) {
+            const auto lock = hold(engine);
             const std::vector<Vec3>& f = engine.forces();
             static_assert(sizeof(Vec3) == 3 * sizeof(double), "rows of three doubles");
             b.apply(add, f.empty() ? nullptr : f.front().data(), f.size());
@@ -174,7 +241,7 @@ PYBIND11_MODULE(_core, m) {
     if (PyErr_Occurred()) throw py::error_already_set();
   });
 
-  py::class_<FlowEngine>(m, "Engine")
+  py::class_<SharedEngine>(m, "Engine")
       .def(py::init<>())
       // Settings: forwarded as they are; the core validates them (validate()) and decides at
       // the next step what a change makes stale.
@@ -188,35 +255,33 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&ConductanceModel::max_ratio))
       .def_property("slip_boundary", get_setting(&EngineSettings::slip_boundary),
                     set_setting(&EngineSettings::slip_boundary))
-      .def_property(
-          "solver", [](const FlowEngine& e) { return std::string(to_string(e.settings.solver)); },
-          [](FlowEngine& e, const std::string& v) {
-            const SolverKind kinds[] = {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient,
-                                        SolverKind::kCholesky};
-            for (SolverKind k : kinds)
-              if (v == to_string(k)) return update(e, [&](EngineSettings& s) { s.solver = k; });
-            throw py::value_error("solver must be one of gauss_seidel, conjugate_gradient, cholesky");
-          })
+      .def_property("solver",
+                    exclusive([](const SharedEngine& e) { return std::string(to_string(e.settings.solver)); }),
+                    exclusive([](SharedEngine& e, const std::string& v) {
+                      const SolverKind kinds[] = {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient,
+                                                  SolverKind::kCholesky};
+                      for (SolverKind k : kinds)
+                        if (v == to_string(k)) return update(e, [&](EngineSettings& s) { s.solver = k; });
+                      throw py::value_error("solver must be one of gauss_seidel, conjugate_gradient, cholesky");
+                    }))
       .def_property("tolerance", get_setting(&EngineSettings::tolerance), set_setting(&EngineSettings::tolerance))
       .def_property("relax", get_setting(&EngineSettings::relax), set_setting(&EngineSettings::relax))
       .def_property("max_iterations", get_setting(&EngineSettings::max_iterations),
                     set_setting(&EngineSettings::max_iterations))
       .def_property("force_metis", get_setting(&EngineSettings::force_metis), set_setting(&EngineSettings::force_metis))
-      .def_property(
-          "ordering",
-          [](const FlowEngine& e) {
-            const char* names[] = {"auto", "amd", "metis", "nesdis"};
-            return std::string(names[static_cast<int>(e.settings.ordering)]);
-          },
-          [](FlowEngine& e, const std::string& v) {
-            const std::map<std::string, Ordering> names{{"auto", Ordering::kAuto},
-                                                        {"amd", Ordering::kAmd},
-                                                        {"metis", Ordering::kMetis},
-                                                        {"nesdis", Ordering::kNestedDissection}};
-            const auto it = names.find(v);
-            if (it == names.end()) throw py::value_error("ordering must be one of auto, amd, metis, nesdis");
-            update(e, [&](EngineSettings& s) { s.ordering = it->second; });
-          })
+      .def_property("ordering", exclusive([](const SharedEngine& e) {
+                      const char* names[] = {"auto", "amd", "metis", "nesdis"};
+                      return std::string(names[static_cast<int>(e.settings.ordering)]);
+                    }),
+                    exclusive([](SharedEngine& e, const std::string& v) {
+                      const std::map<std::string, Ordering> names{{"auto", Ordering::kAuto},
+                                                                  {"amd", Ordering::kAmd},
+                                                                  {"metis", Ordering::kMetis},
+                                                                  {"nesdis", Ordering::kNestedDissection}};
+                      const auto it = names.find(v);
+                      if (it == names.end()) throw py::value_error("ordering must be one of auto, amd, metis, nesdis");
+                      update(e, [&](EngineSettings& s) { s.ordering = it->second; });
+                    }))
       .def_property("mixed_precision", get_setting(&EngineSettings::mixed_precision),
                     set_setting(&EngineSettings::mixed_precision))
       .def_property("mixed_precision_min_entries", get_setting(&EngineSettings::mixed_precision_min_entries),
@@ -227,13 +292,16 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&EngineSettings::cholmod_openmp_teams))
       .def_property("reuse_ordering", get_setting(&EngineSettings::reuse_ordering),
                     set_setting(&EngineSettings::reuse_ordering))
-      .def("ordering_reused", [](const FlowEngine& e) { return e.cholesky() && e.cholmod().ordering_given(); })
-      .def("factor_fill", [](const FlowEngine& e) { return e.cholesky() ? e.cholmod().fill() : 0.0; })
+      .def("ordering_reused",
+           exclusive([](const SharedEngine& e) { return e.cholesky() && e.cholmod().ordering_given(); }))
+      .def("factor_fill", exclusive([](const SharedEngine& e) { return e.cholesky() ? e.cholmod().fill() : 0.0; }))
       .def("reduced_precision_factor",
-           [](const FlowEngine& e) { return e.cholesky() && e.cholmod().reduced_precision(); })
-      .def("refinement_contraction", &FlowEngine::refinement_contraction)
-      .def("factor_nonzeros", [](const FlowEngine& e) { return e.cholesky() ? e.cholmod().factor_nonzeros() : 0.0; })
-      .def("factor_flops", [](const FlowEngine& e) { return e.cholesky() ? e.cholmod().factor_flops() : 0.0; })
+           exclusive([](const SharedEngine& e) { return e.cholesky() && e.cholmod().reduced_precision(); }))
+      .def("refinement_contraction", exclusive(&FlowEngine::refinement_contraction))
+      .def("factor_nonzeros",
+           exclusive([](const SharedEngine& e) { return e.cholesky() ? e.cholmod().factor_nonzeros() : 0.0; }))
+      .def("factor_flops",
+           exclusive([](const SharedEngine& e) { return e.cholesky() ? e.cholmod().factor_flops() : 0.0; }))
       .def_property("fluid_bulk_modulus", get_setting(&EngineSettings::fluid_bulk_modulus),
                     set_setting(&EngineSettings::fluid_bulk_modulus))
       .def_property("background_remesh", get_setting(&EngineSettings::background_remesh),
@@ -242,164 +310,162 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&EngineSettings::viscous_shear),
                     "Viscous shear between neighbouring spheres (YADE's viscousShear); switching it on remeshes at the "
                     "next step.")
-      .def("remesh_pending", &FlowEngine::remesh_pending)
-      .def("wait_for_remesh", &FlowEngine::wait_for_remesh, py::call_guard<py::gil_scoped_release>())
+      .def("remesh_pending", exclusive(&FlowEngine::remesh_pending))
+      .def("wait_for_remesh", exclusive([](const SharedEngine& e) {
+             py::gil_scoped_release release;
+             e.wait_for_remesh();
+           }))
       .def_property("mesh_update_interval", get_setting(&EngineSettings::mesh_update_interval),
                     set_setting(&EngineSettings::mesh_update_interval))
       .def_property("def_tolerance", get_setting(&EngineSettings::def_tolerance),
                     set_setting(&EngineSettings::def_tolerance))
       .def_property("p_zero", get_setting(&EngineSettings::p_zero), set_setting(&EngineSettings::p_zero))
       // Boundary conditions.
-      .def_property(
-          "bnd_is_pressure", [](const FlowEngine& e) { return e.bc.is_pressure; },
-          [](FlowEngine& e, const std::array<bool, 6>& v) { e.bc.is_pressure = v; })
-      .def_property(
-          "bnd_value", [](const FlowEngine& e) { return e.bc.value; },
-          [](FlowEngine& e, const std::array<double, 6>& v) { e.bc.value = v; })
-      .def("impose_pressure",
-           [](FlowEngine& e, const std::array<double, 3>& x, double p) {
-             e.bc.imposed_pressure.push_back({Vec3(x[0], x[1], x[2]), p});
-             return static_cast<int>(e.bc.imposed_pressure.size()) - 1;
-           })
-      .def("set_imposed_pressure",
-           [](FlowEngine& e, int i, double p) {
+      .def_property("bnd_is_pressure", exclusive([](const SharedEngine& e) { return e.bc.is_pressure; }),
+                    exclusive([](SharedEngine& e, const std::array<bool, 6>& v) { e.bc.is_pressure = v; }))
+      .def_property("bnd_value", exclusive([](const SharedEngine& e) { return e.bc.value; }),
+                    exclusive([](SharedEngine& e, const std::array<double, 6>& v) {
+                      BoundaryConditions bc = e.bc;
+                      bc.value = v;
+                      validate(bc);
+                      e.bc = bc;
+                    }))
+      .def("impose_pressure", exclusive([](SharedEngine& e, const std::array<double, 3>& x, double p) {
+             return add_point_condition(e, e.bc.imposed_pressure, {Vec3(x[0], x[1], x[2]), p});
+           }))
+      .def("set_imposed_pressure", exclusive([](SharedEngine& e, int i, double p) {
              if (i < 0 || i >= static_cast<int>(e.bc.imposed_pressure.size()))
                throw py::index_error("no imposed pressure with index " + std::to_string(i));
+             if (!std::isfinite(p)) throw py::value_error("imposed pressure " + std::to_string(i) + " must be finite");
              e.bc.imposed_pressure[i].value = p;
-           })
-      .def("clear_imposed_pressure", [](FlowEngine& e) { e.bc.imposed_pressure.clear(); })
-      .def("impose_flux",
-           [](FlowEngine& e, const std::array<double, 3>& x, double q) {
-             e.bc.imposed_flux.push_back({Vec3(x[0], x[1], x[2]), q});
-             return static_cast<int>(e.bc.imposed_flux.size()) - 1;
-           })
-      .def("clear_imposed_flux", [](FlowEngine& e) { e.bc.imposed_flux.clear(); })
-      .def("request_remesh", &FlowEngine::request_remesh)
-      .def("request_system_rebuild", &FlowEngine::request_system_rebuild)
-      .def("reset_history", &FlowEngine::reset_history)
-      .def("remesh_due", &FlowEngine::remesh_due)
-      .def("has_mesh", &FlowEngine::has_mesh)
+           }))
+      .def("clear_imposed_pressure", exclusive([](SharedEngine& e) { e.bc.imposed_pressure.clear(); }))
+      .def("impose_flux", exclusive([](SharedEngine& e, const std::array<double, 3>& x, double q) {
+             return add_point_condition(e, e.bc.imposed_flux, {Vec3(x[0], x[1], x[2]), q});
+           }))
+      .def("clear_imposed_flux", exclusive([](SharedEngine& e) { e.bc.imposed_flux.clear(); }))
+      .def("request_remesh", exclusive(&FlowEngine::request_remesh))
+      .def("request_system_rebuild", exclusive(&FlowEngine::request_system_rebuild))
+      .def("reset_history", exclusive(&FlowEngine::reset_history))
+      .def("release", exclusive(&FlowEngine::release),
+           "Free the mesh, the system and the results (settings kept); the next step remeshes.")
+      .def("remesh_due", exclusive(&FlowEngine::remesh_due))
+      .def("has_mesh", exclusive(&FlowEngine::has_mesh))
       // The step.
-      .def(
-          "step",
-          [](FlowEngine& e, const Array& centres, const Array& radii, const std::array<double, 6>& walls, double dt) {
-            auto c = to_points(centres, "positions");
-            auto r = to_vector(radii, "radii");
-            const BoxWalls w = to_walls(walls);
-            py::gil_scoped_release release;
-            e.step(c, r, w, dt);
-          },
-          py::arg("positions"), py::arg("radii"), py::arg("walls"), py::arg("dt"))
-      .def(
-          "viscous_stability_limit",
-          [](const FlowEngine& e, const Array& mass, int iterations) {
-            auto m = to_vector(mass, "masses");
-            py::gil_scoped_release release;
-            return e.viscous_stability_limit(m, iterations);
-          },
-          py::arg("masses"), py::arg("iterations") = 40)
-      .def(
-          "viscous_stability_mode",
-          [](const FlowEngine& e, const Array& mass, int iterations, py::object start) {
-            auto m = to_vector(mass, "masses");
-            std::vector<Vec3> mode;
-            if (!start.is_none()) mode = to_points(start.cast<Array>(), "start");
-            double limit;
-            int applications = 0;
-            {
-              py::gil_scoped_release release;
-              limit = e.viscous_stability_limit(m, iterations, &mode, &applications);
-            }
-            return py::make_tuple(limit, points_to_array(mode), applications);
-          },
-          py::arg("masses"), py::arg("iterations") = 40, py::arg("start") = py::none(),
-          "(limit, mode, applications): as viscous_stability_limit, by power iteration from `start` (one\n"
-          "velocity per sphere, e.g. the mode returned on the previous mesh) when given, else by Arnoldi; mode is\n"
-          "the estimated eigenvector, applications the operator applications made (each a solve).")
-      .def(
-          "forces", [](const FlowEngine& e) { return points_to_array(e.forces()); },
-          "Fluid force on every sphere (input order), then on the six walls.")
-      .def(
-          "shear_forces", [](const FlowEngine& e) { return points_to_array(e.shear_forces()); },
-          "The viscous shear part of forces() (empty while viscous_shear is off).")
-      .def(
-          "shear_pairs",
-          [](const FlowEngine& e) {
-            const ViscousShear* s = meshed(e).viscous_shear();
-            if (!s) throw py::value_error("viscous_shear is off: the mesh has no shear pairs");
-            py::dict d;
-            d["a"] = vector_to_array(s->a);
-            d["b"] = vector_to_array(s->b);
-            d["direction"] = points_to_array(s->direction);
-            d["area"] = vector_to_array(s->area);
-            d["hydraulic_radius"] = vector_to_array(s->hydraulic_radius);
-            d["open_rings"] = s->open_rings;
-            return d;
-          },
-          "Pairs of the shear term: vertices a, b (b >= n spheres: wall), unit a->b, S_vor, R_h.")
-      .def("pressure", [](const FlowEngine& e) { return vector_to_array(e.pressure()); })
+      .def("step",
+           exclusive([](SharedEngine& e, const Array& centres, const Array& radii, const std::array<double, 6>& walls,
+                        double dt) {
+             auto c = to_points(centres, "positions");
+             auto r = to_vector(radii, "radii");
+             const BoxWalls w = to_walls(walls);
+             py::gil_scoped_release release;
+             e.step(c, r, w, dt);
+           }),
+           py::arg("positions"), py::arg("radii"), py::arg("walls"), py::arg("dt"))
+      .def("viscous_stability_limit", exclusive([](const SharedEngine& e, const Array& mass, int iterations) {
+             auto m = to_vector(mass, "masses");
+             py::gil_scoped_release release;
+             return e.viscous_stability_limit(m, iterations);
+           }),
+           py::arg("masses"), py::arg("iterations") = 40)
+      .def("viscous_stability_mode",
+           exclusive([](const SharedEngine& e, const Array& mass, int iterations, py::object start) {
+             auto m = to_vector(mass, "masses");
+             std::vector<Vec3> mode;
+             if (!start.is_none()) mode = to_points(start.cast<Array>(), "start");
+             double limit;
+             int applications = 0;
+             {
+               py::gil_scoped_release release;
+               limit = e.viscous_stability_limit(m, iterations, &mode, &applications);
+             }
+             return py::make_tuple(limit, points_to_array(mode), applications);
+           }),
+           py::arg("masses"), py::arg("iterations") = 40, py::arg("start") = py::none(),
+           "(limit, mode, applications): as viscous_stability_limit, by power iteration from `start` (one\n"
+           "velocity per sphere, e.g. the mode returned on the previous mesh) when given, else by Arnoldi; mode is\n"
+           "the estimated eigenvector, applications the operator applications made (each a solve).")
+      .def("forces", exclusive([](const SharedEngine& e) { return points_to_array(e.forces()); }),
+           "Fluid force on every sphere (input order), then on the six walls.")
+      .def("shear_forces", exclusive([](const SharedEngine& e) { return points_to_array(e.shear_forces()); }),
+           "The viscous shear part of forces() (empty while viscous_shear is off).")
+      .def("shear_pairs", exclusive([](const SharedEngine& e) {
+             const ViscousShear* s = meshed(e).viscous_shear();
+             if (!s) throw py::value_error("viscous_shear is off: the mesh has no shear pairs");
+             py::dict d;
+             d["a"] = vector_to_array(s->a);
+             d["b"] = vector_to_array(s->b);
+             d["direction"] = points_to_array(s->direction);
+             d["area"] = vector_to_array(s->area);
+             d["hydraulic_radius"] = vector_to_array(s->hydraulic_radius);
+             d["open_rings"] = s->open_rings;
+             return d;
+           }),
+           "Pairs of the shear term: vertices a, b (b >= n spheres: wall), unit a->b, S_vor, R_h.")
+      .def("pressure", exclusive([](const SharedEngine& e) { return vector_to_array(e.pressure()); }))
       // Queries.
-      .def("n_cells", [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().n_cells() : 0; })
-      .def("boundary_flux",
-           [](const FlowEngine& e, int w) {
+      .def("n_cells", exclusive([](const SharedEngine& e) { return e.has_mesh() ? e.mesh().n_cells() : 0; }))
+      .def("boundary_flux", exclusive([](const SharedEngine& e, int w) {
              check_wall(w);
              return e.boundary_flux(w);
-           })
-      .def("imposed_flux_total", &FlowEngine::imposed_flux_total)
-      .def("volume_rate_total", &FlowEngine::volume_rate_total)
-      .def("average_pressure", &FlowEngine::average_pressure)
-      .def("average_slice_pressure", &FlowEngine::average_slice_pressure)
-      .def("locate",
-           [](const FlowEngine& e, const std::array<double, 3>& x) { return e.locate(Vec3(x[0], x[1], x[2])); })
-      .def("cell_pressure",
-           [](const FlowEngine& e, int id) {
+           }))
+      .def("imposed_flux_total", exclusive(&FlowEngine::imposed_flux_total))
+      .def("volume_rate_total", exclusive(&FlowEngine::volume_rate_total))
+      .def("average_pressure", exclusive(&FlowEngine::average_pressure))
+      .def("average_slice_pressure", exclusive(&FlowEngine::average_slice_pressure))
+      .def("locate", exclusive([](const SharedEngine& e, const std::array<double, 3>& x) {
+             return e.locate(Vec3(x[0], x[1], x[2]));
+           }))
+      .def("cell_pressure", exclusive([](const SharedEngine& e, int id) {
              check_cell(e, id);
              return e.pressure()[id];
-           })
-      .def("cell_center",
-           [](const FlowEngine& e, int id) {
+           }))
+      .def("cell_center", exclusive([](const SharedEngine& e, int id) {
              check_cell(e, id);
              const Vec3& c = meshed(e).cells().power_centre[id];
              return std::array<double, 3>{c.x(), c.y(), c.z()};
-           })
-      .def("cell_volume",
-           [](const FlowEngine& e, int id) {
+           }))
+      .def("cell_volume", exclusive([](const SharedEngine& e, int id) {
              check_cell(e, id);
              return meshed(e).cells().volume[id];
-           })
-      .def("cell_fluid_volume",
-           [](const FlowEngine& e, int id) {
+           }))
+      .def("cell_fluid_volume", exclusive([](const SharedEngine& e, int id) {
              check_cell(e, id);
              return meshed(e).cells().fluid_volume[id];
-           })
-      .def("metis_used", &FlowEngine::metis_used)
+           }))
+      .def("metis_used", exclusive(&FlowEngine::metis_used))
       .def("hidden_spheres",
-           [](const FlowEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; })
-      .def_property_readonly("remesh_count", &FlowEngine::remesh_count)
-      .def_property_readonly("system_builds", &FlowEngine::system_builds)
-      .def_property_readonly(
-          "sweeps", [](const FlowEngine& e) { return e.last_solve().sweeps; }, "Gauss-Seidel sweeps of the last solve.")
-      .def_property_readonly(
-          "cg_iterations", [](const FlowEngine& e) { return e.last_solve().cg_iterations; },
-          "Conjugate-gradient iterations of the last solve.")
-      .def_property_readonly(
-          "refinement_passes", [](const FlowEngine& e) { return e.last_solve().refinement_passes; },
-          "Refinement passes of the last solve with a 32-bit factor.")
-      .def_property_readonly("accumulated_strain", &FlowEngine::accumulated_strain)
-      .def("walls", [](const FlowEngine& e) { return e.walls().coord; })
-      .def("remesh_times", [](const FlowEngine& e) { return times_dict(e.remesh_times()); })
-      .def("step_times", [](const FlowEngine& e) { return times_dict(e.step_times()); })
+           exclusive([](const SharedEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; }))
+      .def_property_readonly("remesh_count", exclusive(&FlowEngine::remesh_count))
+      .def_property_readonly("inversion_remeshes", exclusive(&FlowEngine::inversion_remeshes),
+                             "Remeshes forced by cells turned inside out (motion too large for the schedule).")
+      .def_property_readonly("mesh_viscosity", exclusive(&FlowEngine::mesh_viscosity),
+                             "The viscosity of the current mesh's conductances.")
+      .def_property_readonly("system_builds", exclusive(&FlowEngine::system_builds))
+      .def_property_readonly("sweeps", exclusive([](const SharedEngine& e) { return e.last_solve().sweeps; }),
+                             "Gauss-Seidel sweeps of the last solve.")
+      .def_property_readonly("cg_iterations",
+                             exclusive([](const SharedEngine& e) { return e.last_solve().cg_iterations; }),
+                             "Conjugate-gradient iterations of the last solve.")
+      .def_property_readonly("refinement_passes",
+                             exclusive([](const SharedEngine& e) { return e.last_solve().refinement_passes; }),
+                             "Refinement passes of the last solve with a 32-bit factor.")
+      .def_property_readonly("accumulated_strain", exclusive(&FlowEngine::accumulated_strain))
+      .def("walls", exclusive([](const SharedEngine& e) { return e.walls().coord; }))
+      .def("remesh_times", exclusive([](const SharedEngine& e) { return times_dict(e.remesh_times()); }))
+      .def("step_times", exclusive([](const SharedEngine& e) { return times_dict(e.step_times()); }))
       // Geometry, for tests and post-processing.
-      .def("cell_vertices",
-           [](const FlowEngine& e) {
+      .def("cell_vertices", exclusive([](const SharedEngine& e) {
              const auto& cv = meshed(e).mesh().cell_vertices;
              py::array_t<int> out({static_cast<py::ssize_t>(cv.size()), py::ssize_t{4}});
              if (!cv.empty()) std::memcpy(out.mutable_data(), cv.data(), cv.size() * sizeof(cv[0]));
              return out;
-           })
-      .def("cell_volumes", [](const FlowEngine& e) { return vector_to_array(meshed(e).cells().volume); })
-      .def("cell_fluid_volumes", [](const FlowEngine& e) { return vector_to_array(meshed(e).cells().fluid_volume); })
-      .def("cell_centers", [](const FlowEngine& e) { return points_to_array(meshed(e).cells().power_centre); })
-      .def("conductances", [](const FlowEngine& e) { return vector_to_array(meshed(e).conductances()); })
-      .def("facet_cells", [](const FlowEngine& e) { return meshed(e).facets().cell; });
+           }))
+      .def("cell_volumes", exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).cells().volume); }))
+      .def("cell_fluid_volumes",
+           exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).cells().fluid_volume); }))
+      .def("cell_centers",
+           exclusive([](const SharedEngine& e) { return points_to_array(meshed(e).cells().power_centre); }))
+      .def("conductances", exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).conductances()); }))
+      .def("facet_cells", exclusive([](const SharedEngine& e) { return meshed(e).facets().cell; }));
 }

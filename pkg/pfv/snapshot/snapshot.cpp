@@ -19,6 +19,12 @@ std::string describe(const Vec3& x) {
   return s.str();
 }
 
+std::string describe(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
 void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls) {
   if (centres.size() != radii.size()) bad_input("positions and radii differ in length");
   if (centres.empty()) bad_input("no spheres to couple with the fluid");
@@ -36,8 +42,17 @@ void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<doubl
     for (int w = 0; w < kWallCount; ++w)
       if (!(walls.height(w, centres[k]) > 0))
         bad_input("sphere " + std::to_string(k) + " centre " + describe(centres[k]) + " is outside wall " +
-                  std::to_string(w) + " (at " + std::to_string(walls.coord[w]) + ")");
+                  std::to_string(w) + " (at " + describe(walls.coord[w]) + ")");
   }
+  // A domain that many radii across cannot be meshed (and its coordinates no longer resolve a
+  // radius): a sphere or a wall has gone far astray.
+  const double largest = *std::max_element(radii.begin(), radii.end());
+  for (int a = 0; a < 3; ++a)
+    if (walls.extent(a) > kMaxDomainRadii * largest)
+      bad_input("walls " + std::to_string(2 * a) + " and " + std::to_string(2 * a + 1) + " are " +
+                describe(walls.extent(a)) + " apart, more than " + describe(kMaxDomainRadii) +
+                " times the largest sphere radius " + describe(largest) +
+                ": a sphere or a wall is far outside the packing");
 }
 
 void check_distinct_centres(const std::vector<Vec3>& centres) {

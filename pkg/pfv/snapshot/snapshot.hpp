@@ -8,8 +8,12 @@
 
 namespace pfv {
 
+// The widest domain accepted, in radii of the largest sphere.
+constexpr double kMaxDomainRadii = 1e6;
+
 // Throws std::invalid_argument naming the first problem: sizes, non-finite or non-positive
-// values, walls out of order, a centre on or outside a wall.
+// values, walls out of order, a centre on or outside a wall, a domain wider than
+// kMaxDomainRadii largest radii along some axis.
 void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls);
 
 // Throws std::invalid_argument if two centres coincide (the triangulation would silently
@@ -17,5 +21,6 @@ void validate_snapshot(const std::vector<Vec3>& centres, const std::vector<doubl
 void check_distinct_centres(const std::vector<Vec3>& centres);
 
 std::string describe(const Vec3& x);  // "(x, y, z)" for messages
+std::string describe(double x);       // six significant digits
 
 }  // namespace pfv

@@ -11,7 +11,12 @@ rules "implemented, refused, misspelt" read in one place, next to the generated 
 from __future__ import annotations
 
 import ast
-from typing import Any, Iterable
+import math
+import numbers
+from collections.abc import Iterable
+from typing import Any
+
+import numpy as np
 
 from ._yade_api import ATTRIBUTES as _YADE_ATTRIBUTES, METHODS as _YADE_METHODS
 
@@ -99,25 +104,75 @@ def use_solver_of(solver: str) -> int:
     return _USE_SOLVER_OF[solver]
 
 
+def _six(name: str, value: Any, kinds: tuple[type, ...], what: str, each: str) -> list[Any]:
+    """The six items of `value`, each an instance of `kinds`, else TypeError naming `name`.
+    Strict as YADE's own converters are: no truthiness of strings or None, no truncation."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
+        raise TypeError(f"{name} must be a sequence of 6 {what} (xmin, xmax, ymin, ymax, zmin, zmax), "
+                        f"got {value!r}")
+    items = list(value)
+    if len(items) != 6:
+        raise ValueError(f"{name} needs 6 values (xmin, xmax, ymin, ymax, zmin, zmax), got {len(items)}")
+    for w, item in enumerate(items):
+        if not isinstance(item, kinds) or isinstance(item, (str, bytes)):
+            raise TypeError(f"{name}[{w}] must be {each}, got {item!r}")
+    return items
+
+
 def as_bool6(name: str, value: Iterable[Any]) -> list[bool]:
-    """Six flags, one per wall (xmin, xmax, ymin, ymax, zmin, zmax)."""
-    value = list(value)
-    if len(value) != 6:
-        raise ValueError(f"{name} needs 6 values (xmin, xmax, ymin, ymax, zmin, zmax)")
-    return [bool(v) for v in value]
+    """Six flags, one per wall (xmin, xmax, ymin, ymax, zmin, zmax): bools or integers."""
+    return [bool(v) for v in _six(name, value, (numbers.Integral, np.bool_), "flags", "a bool")]
 
 
 def as_float6(name: str, value: Iterable[Any]) -> list[float]:
-    """Six numbers, one per wall (xmin, xmax, ymin, ymax, zmin, zmax)."""
-    value = [float(v) for v in value]
-    if len(value) != 6:
-        raise ValueError(f"{name} needs 6 values (xmin, xmax, ymin, ymax, zmin, zmax)")
-    return value
+    """Six finite numbers, one per wall (xmin, xmax, ymin, ymax, zmin, zmax)."""
+    items = [float(v) for v in _six(name, value, (numbers.Real,), "numbers", "a number")]
+    for w, v in enumerate(items):
+        if not math.isfinite(v):
+            raise ValueError(f"{name}[{w}] must be finite, got {v!r}")
+    return items
 
 
 def as_wall_ids(value: Iterable[Any]) -> list[int]:
-    """Six body ids, one per wall (xmin, xmax, ymin, ymax, zmin, zmax)."""
-    value = [int(v) for v in value]
-    if len(value) != 6:
-        raise ValueError("wallIds needs 6 body ids (xmin, xmax, ymin, ymax, zmin, zmax)")
+    """Six body ids, one per wall (xmin, xmax, ymin, ymax, zmin, zmax): integers, not floats."""
+    return [int(v) for v in _six("wallIds", value, (numbers.Integral,), "body ids", "an integer body id")]
+
+
+def as_point(name: str, value: Any) -> tuple[float, float, float]:
+    """A finite point (x, y, z)."""
+    if isinstance(value, (str, bytes)):
+        raise TypeError(f"{name} must be a point (x, y, z) of numbers, got {value!r}")
+    try:
+        point = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a point (x, y, z) of numbers, got {value!r}") from None
+    if len(point) != 3 or not all(math.isfinite(v) for v in point):
+        raise ValueError(f"{name} must be a finite point (x, y, z), got {value!r}")
+    return point
+
+
+def as_setting(name: str, value: Any, current: Any) -> Any:
+    """`value` checked for the core setting behind YADE attribute `name`, whose current value
+    `current` gives the type: a flag (bool or integer), an integer, or a finite number. The core
+    checks the ranges; this names the attribute when the type is wrong."""
+    if isinstance(current, bool):
+        if not isinstance(value, (numbers.Integral, np.bool_)):
+            raise TypeError(f"{name} must be a bool, got {value!r}")
+        return bool(value)
+    if isinstance(current, int):
+        if not isinstance(value, numbers.Integral) or isinstance(value, (bool, np.bool_)):
+            raise TypeError(f"{name} must be an integer, got {value!r}")
+        return int(value)
+    if isinstance(current, float):
+        return as_number(name, value)
+    return value
+
+
+def as_number(name: str, value: Any) -> float:
+    """A finite float."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be finite, got {value!r}")
     return value

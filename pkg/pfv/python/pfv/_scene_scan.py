@@ -11,19 +11,21 @@ engine because it is the only part that knows YADE's body layout.
 """
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Sequence
 
 import numpy as np
 
 import yade
-from yade.wrapper import Sphere, Box
+from yade.wrapper import Box, Facet, Sphere, Wall
 from yade.minieigenHP import Vector3
 from yade._packSpheres import SpherePack
 
 from ._core import YadeForceBridge, gather_axis, gather_sphere_pack, sphere_pack_size
 
 _coordinates = yade._utils.coordsAndDisplacements
+_WALL_SHAPES = (Box, Wall, Facet)  # the shapes a body named in wallIds may have
 
 
 class SceneScan:
@@ -67,12 +69,18 @@ class SceneScan:
                 rows.append(row)
                 state = b.state
                 mass = state.mass
+                if not math.isfinite(mass) or mass < 0:
+                    raise ValueError(f"pfv.FlowEngine: sphere #{bid} has mass {mass}: a coupled sphere needs a "
+                                     "finite mass >= 0")
                 moving = b.dynamic and mass > 0 and state.blockedDOFs != "xyzXYZ"
                 masses.append(mass if moving else 0.0)
                 if moving:
                     mass_per_diameter = min(mass_per_diameter, mass / (2 * radius))
             else:
                 others += 1
+        if not ids:
+            raise ValueError(f"pfv.FlowEngine: the scene has no sphere to couple with the fluid "
+                             f"({len(row_of)} bodies, walls wallIds = {self.wall_ids})")
         if clumps:
             raise NotImplementedError(
                 f"pfv.FlowEngine does not support clumps yet ({clumps} clump bodies or members in the scene)")
@@ -92,6 +100,10 @@ class SceneScan:
                 wall_half.append(0.0)
                 continue
             b = scene.bodies[bid]
+            # The body's position bounds the domain unless boundaryUseMaxMin: it must be a wall.
+            if not use_max_min[w] and (not isinstance(b.shape, _WALL_SHAPES) or b.isClump or b.isClumpMember):
+                raise ValueError(f"wallIds[{w}] = {bid} names a {type(b.shape).__name__} body, not a wall "
+                                 "(a Box, Wall or Facet)")
             wall_rows.append(row_of[bid])
             # A box wall bounds the domain with its inner face.
             half = b.shape.extents[w // 2] if isinstance(b.shape, Box) else 0.0
@@ -113,6 +125,7 @@ class SceneScan:
         dem = yade.utils.PWaveTimeStep() if ids else float("inf")
         self.dt_dem = dem if dem > 0 else float("inf")
         self._positions = previous._positions if previous is not None else None
+        self._wall_setter: dict[int, int] = {}  # wall -> sphere that placed it (boundaryUseMaxMin)
         self.pack: SpherePack | None = None  # a SpherePack whose array this scan reads, or None
         self.pack_index: np.ndarray | None = None  # the spheres' places in the pack
         self.pack_size = 0  # sphere bodies in the pack
@@ -184,5 +197,18 @@ class SceneScan:
         for w in range(6):
             if use_max_min[w]:
                 axis = w // 2
-                walls[w] = float((pos[:, axis] + self.radii).max() if w % 2 else (pos[:, axis] - self.radii).min())
+                extreme = pos[:, axis] + self.radii if w % 2 else self.radii - pos[:, axis]
+                k = int(extreme.argmax())
+                walls[w] = float(pos[k, axis] + self.radii[k] if w % 2 else pos[k, axis] - self.radii[k])
+                self._wall_setter[w] = k
+            else:
+                self._wall_setter.pop(w, None)
         return pos, walls
+
+    def describe_wall_setter(self, w: int) -> str | None:
+        """"wall w is placed by sphere #id at (x, y, z)" when boundaryUseMaxMin placed it, else None."""
+        k = self._wall_setter.get(w)
+        if k is None or self._positions is None or k >= len(self.ids):
+            return None
+        return (f"wall {w} is placed by sphere #{self.ids[k]} at {tuple(self._positions[k].tolist())} "
+                "(boundaryUseMaxMin)")

@@ -11,11 +11,15 @@ core, the masses and the limits. Kept apart so that the warning logic is readabl
 """
 from __future__ import annotations
 
+import collections
 import time
 import warnings
 from typing import Any
 
 import numpy as np
+
+
+HISTORY_LENGTH = 200  # computations of the collective limit kept in the history
 
 
 class TimeStepWarning(UserWarning):
@@ -39,22 +43,34 @@ class TimeStepGuard:
         self._computed_for: tuple[float, bool] | None = None  # (viscosity, viscous_shear) of the limit
         self._mesh: int | None = None  # core.remesh_count the limit was computed on
         self._mode: np.ndarray | None = None  # its eigenvector, the next mesh's start
-        self._history: list[dict[str, Any]] = []
+        # The latest computations (a long run remeshes without end: the record must not grow).
+        self._history: collections.deque[dict[str, Any]] = collections.deque(maxlen=HISTORY_LENGTH)
         self._unsafe = False
 
-    def mesh_changed(self, core: Any) -> bool:
-        """Whether the core has a mesh the collective limit was not computed on yet."""
-        return self._mesh != core.remesh_count
+    @staticmethod
+    def _key(core: Any) -> tuple[float, bool]:
+        # The viscosity of the mesh's conductances (a new one applies at the next step), and the
+        # shear term, which adds damping to the operator (switched on, its pairs arrive with a
+        # remesh, which recomputes again).
+        return core.mesh_viscosity, core.viscous_shear
+
+    def stale(self, core: Any) -> bool:
+        """Whether the core has a mesh, or conductances, the collective limit was not computed for."""
+        return core.has_mesh() and (self._mesh != core.remesh_count or self._computed_for != self._key(core))
+
+    def known_limit(self, core: Any) -> float:
+        """The collective limit if already computed for the core's mesh as it is, else inf."""
+        if self._limit is None or self.stale(core) or core.remesh_due():
+            return float("inf")
+        return self._limit
 
     def collective_limit(self, core: Any, masses: np.ndarray, iteration: int) -> float:
         """The collective viscous limit of the core's mesh, computed again on a new mesh or when the
         viscosity or the shear term changed; `iteration` (O.iter) goes into the history."""
         if not core.has_mesh():
             return float("inf")
-        # The shear term adds damping to the operator, so switching it recomputes the limit too
-        # (switched on, its pairs arrive with a remesh, which recomputes again).
-        key = (core.viscosity, core.viscous_shear)
-        if self.mesh_changed(core) or self._computed_for != key:
+        key = self._key(core)
+        if self.stale(core):
             mode = self._mode
             warm = mode is not None and len(mode) == len(masses) and self._limit is not None
             iterations = self.iterations_warm if warm else self.iterations
@@ -72,7 +88,7 @@ class TimeStepGuard:
 
     @property
     def history(self) -> list[dict[str, Any]]:
-        """A copy of the list of computations of the collective limit (one dict each)."""
+        """The latest HISTORY_LENGTH computations of the collective limit (one dict each), oldest first."""
         return list(self._history)
 
     def check(self, dt: float, dt_mv: float, dt_collective: float, dt_dem: float) -> None:

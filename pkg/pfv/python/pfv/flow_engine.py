@@ -15,7 +15,12 @@ guard (``_time_step.TimeStepGuard``).
 """
 from __future__ import annotations
 
+import contextlib
+import functools
+import numbers
 import re
+import threading
+import uuid
 import warnings
 import weakref
 from collections.abc import Sequence
@@ -35,6 +40,12 @@ from ._time_step import TimeStepGuard, TimeStepWarning, viscous_time_step
 __all__ = ["FlowEngine", "TimeStepWarning"]
 
 _engines = weakref.WeakValueDictionary()  # PyRunner commands find their engine here
+# Keys of the engines that hold a mesh. YADE keeps a reference to every engine ever put into
+# O.engines, so an engine taken out is never freed: the step of an engine in use frees the mesh
+# of those no longer in their scene (_release_unused).
+_holding: set[int] = set()
+_MAX_THREADS = 1024  # ompThreads beyond this is a typo, not a machine
+_SCENE_TAG = "pfv.FlowEngine"  # key in O.tags of the token that tells this scene from a new one
 
 
 def _run(key: int) -> None:
@@ -49,11 +60,29 @@ def _run(key: int) -> None:
     engine._step()
 
 
+def _release_unused(current: FlowEngine) -> None:
+    """Free the meshes of the engines that ran in the current scene but are no longer in O.engines."""
+    others = [key for key in _holding if key != current._key]
+    if not others:
+        return
+    engines = yade.O.engines
+    for key in others:
+        engine = _engines.get(key)
+        if engine is None:
+            _holding.discard(key)
+        elif engine._in_scene(yade.O) and not any(e is engine for e in engines):
+            engine._release()
+
+
 # Python-side state of a FlowEngine (not YADE attributes), set as plain instance attributes.
 _INTERNAL = frozenset({
     "_core",                  # the C++ engine
     "_key",                   # its key in _engines
+    "_lock",                  # held by a step and by every query (O.run steps on YADE's own thread)
     "_scan",                  # the last SceneScan, None before the first step
+    "_stepped",               # the SceneScan of the last successful step: the current mesh's spheres
+    "_scene_tag",             # the value this engine left in O.tags: a new scene lacks it
+    "_last_step",             # (O.iter, O.time) of the last successful step, None: no history
     "_guard",                 # the TimeStepGuard
     "_boundary_use_max_min",  # boundaryUseMaxMin
     "_wall_ids",              # wallIds
@@ -61,6 +90,16 @@ _INTERNAL = frozenset({
     "_threads",               # ompThreads, None: follow YADE's -j
     "_use_sphere_pack",       # False: always read the coordinate lists
 })
+
+
+def _exclusive(method):
+    """Run `method` under the engine's lock: a query made while YADE's simulation thread is inside
+    a step waits for that step, and never sees a mesh being rebuilt."""
+    @functools.wraps(method)
+    def locked(self, *args, **kwargs):
+        with self._lock:
+            return method(self, *args, **kwargs)
+    return locked
 
 
 def _guard_setting(name: str, doc: str) -> property:
@@ -78,6 +117,10 @@ class FlowEngine(PyRunner):
         PyRunner.__init__(self)
         self._core = Engine()
         self._key = id(self)
+        self._lock = threading.RLock()
+        self._stepped = None
+        self._scene_tag = None
+        self._last_step = None
         self._boundary_use_max_min = [True] * 6
         self._wall_ids = list(range(6))
         self._warned = set()
@@ -95,7 +138,13 @@ class FlowEngine(PyRunner):
     # -- attribute surface -------------------------------------------------------------
     def __setattr__(self, name: str, value: Any) -> None:
         if name in attributes.CORE_NAME:
-            setattr(self._core, attributes.CORE_NAME[name], value)
+            core_name = attributes.CORE_NAME[name]
+            value = attributes.as_setting(name, value, getattr(self._core, core_name))
+            with self._lock:
+                try:
+                    setattr(self._core, core_name, value)
+                except ValueError as error:
+                    raise ValueError(f"pfv.FlowEngine.{name}: {error}") from None
         elif name in _INTERNAL or name in _OWN_ATTRIBUTES:
             object.__setattr__(self, name, value)
         elif attributes.is_yade_attribute(name):
@@ -178,7 +227,11 @@ class FlowEngine(PyRunner):
 
     @ompThreads.setter
     def ompThreads(self, value: int) -> None:
-        self._threads = int(value) if int(value) > 0 else None
+        if not isinstance(value, numbers.Integral) or isinstance(value, bool):
+            raise TypeError(f"ompThreads must be an integer, got {value!r}")
+        if value > _MAX_THREADS:
+            raise ValueError(f"ompThreads = {value} is more than {_MAX_THREADS} threads")
+        self._threads = int(value) if value > 0 else None
 
     # -- time-step guard settings (held by the TimeStepGuard) --------------------------------
     time_step_safety = _guard_setting(
@@ -215,9 +268,53 @@ class FlowEngine(PyRunner):
         since the last scan."""
         return self._scan.read_positions(self._boundary_use_max_min)
 
+    def _in_scene(self, scene: Any) -> bool:
+        """Whether this engine last ran in `scene` (which then holds its tag)."""
+        try:
+            return self._scene_tag is not None and scene.tags[f"{_SCENE_TAG}.{self._key}"] == self._scene_tag
+        except KeyError:
+            return False
+
+    @_exclusive
+    def _release(self) -> None:
+        """Free the mesh and the scan (settings kept): the next step starts afresh."""
+        self._core.release()
+        self._scan = self._stepped = None
+        self._last_step = None
+        _holding.discard(self._key)
+
+    def _notice_new_scene(self, scene: Any) -> None:
+        """After O.reset() (or O.switchScene) the engine may be put into a scene it has never
+        seen, possibly with as many bodies as the last one: forget everything of the old one."""
+        if self._in_scene(scene):
+            return
+        if self._scene_tag is not None:  # not the first step: a new scene
+            # The collective limit follows with the new mesh (its history and the mode that warm
+            # starts it carry over: the mode is only a starting vector).
+            self._scan = self._stepped = None
+            self._core.request_remesh()
+            self._core.reset_history()
+            self._last_step = None
+        self._scene_tag = uuid.uuid4().hex
+        scene.tags[f"{_SCENE_TAG}.{self._key}"] = self._scene_tag
+
+    def _time_since_last_step(self, scene: Any) -> float:
+        """The time the positions moved over since the last step of this engine, or O.dt with the
+        history forgotten when that step was not the last iteration's run of the engine (it was
+        dead, its iterPeriod skipped, or the last step failed): dV/dt must not span a gap."""
+        last = self._last_step
+        period = max(1, int(self.iterPeriod))
+        if last is not None and scene.iter - last[0] == period:
+            return scene.dt if period == 1 else scene.time - last[1]
+        if last is not None:
+            self._core.reset_history()
+        return scene.dt
+
+    @_exclusive
     def _step(self) -> None:
         scene = yade.O
         core = self._core
+        self._notice_new_scene(scene)
         scan = self._scan
         bodies_changed = scan is None or scan.outdated or len(scene.bodies) != scan.n_bodies
         if bodies_changed or core.remesh_due():
@@ -232,19 +329,29 @@ class FlowEngine(PyRunner):
         scan = self._scan
         pos, walls = read
         set_num_threads(self._threads or scene.numThreads)
-        self._check_time_step(scene.dt)
+        dt = self._time_since_last_step(scene)
+        # Before the step, only limits known for the mesh the step will use (a mesh about to be
+        # rebuilt, or conductances about to change, have no limit yet: checked after the step).
+        self._check_time_step(scene.dt, scan, collective=self._guard.known_limit(core))
         remeshing = core.remesh_due()
-        try:
-            core.step(pos, scan.radii, walls, scene.dt)
-        except ValueError as error:  # name bodies by their YADE id, not by sphere index
-            ids = scan.ids
-            message = re.sub(r"sphere (\d+)", lambda m: f"sphere #{ids[int(m.group(1))]}", str(error))
-            raise ValueError(f"pfv.FlowEngine: {message}") from None
-        if self._guard.mesh_changed(core):
-            # A new mesh (the first, or a remesh adopted by this step): its collective limit may be
-            # lower (a compacting sample), check again.
-            self._check_time_step(scene.dt)
-        if remeshing:
+        inversions = core.inversion_remeshes
+        with self._bodies_named(scan):
+            core.step(pos, scan.radii, walls, dt)
+        self._stepped = scan
+        self._last_step = (scene.iter, scene.time)
+        _holding.add(self._key)
+        _release_unused(self)
+        if self._guard.stale(core):
+            # A new mesh (the first, or a remesh adopted by this step) or new conductances: its
+            # collective limit may be lower (a compacting sample), check again.
+            self._check_time_step(scene.dt, scan)
+        if core.inversion_remeshes != inversions and "inverted" not in self._warned:
+            self._warned.add("inverted")
+            warnings.warn(f"pfv.FlowEngine: at iteration {scene.iter} spheres had moved so far since the last "
+                          "remesh that pore cells were turned inside out; remeshed (and will again whenever "
+                          "this happens). Lower meshUpdateInterval or defTolerance for motion this fast",
+                          stacklevel=2)
+        if remeshing or core.inversion_remeshes != inversions:
             hidden = core.hidden_spheres()
             if hidden:
                 yade_ids = scan.ids[hidden][:10].tolist()
@@ -254,7 +361,22 @@ class FlowEngine(PyRunner):
         # The engine's force array is read in C++, without a numpy copy.
         scan.force_bridge.apply(scene.forces.addF, core)
 
+    @contextlib.contextmanager
+    def _bodies_named(self, scan: SceneScan):
+        """Errors of the core name spheres by their index in the scan and walls by number: say
+        which YADE body is meant, and which sphere set a wall placed by boundaryUseMaxMin."""
+        try:
+            yield
+        except (ValueError, RuntimeError) as error:
+            message = re.sub(r"sphere (\d+)", lambda m: f"sphere #{scan.ids[int(m.group(1))]}", str(error))
+            setters = [scan.describe_wall_setter(int(w)) for w in sorted(set(re.findall(r"walls? (\d)", message)))]
+            setters = [s for s in setters if s]
+            if setters:
+                message += " (" + "; ".join(setters) + ")"
+            raise type(error)(f"pfv.FlowEngine: {message}") from None
+
     @property
+    @_exclusive
     def viscous_time_step(self) -> float:
         """dt_MV = pi rho d^2 / (1200 mu) at the smallest rho d^2 of the coupled dynamic spheres (thesis 4.20)."""
         return viscous_time_step(self._scanned().mass_per_diameter, self._core.viscosity)
@@ -270,10 +392,11 @@ class FlowEngine(PyRunner):
         previous mesh's mode (at most collective_iterations_warm = 10). Each operator application
         costs one back-substitution and one force evaluation; see collective_viscous_history
         ("iterations" there is the count made, "max_iterations" the cap, "seconds" the cost)."""
-        if not self._core.has_mesh():
-            return float("inf")
-        # The masses of the scan the mesh was built from (even if wallIds changed since).
-        return self._guard.collective_limit(self._core, self._scan.masses, yade.O.iter)
+        with self._lock:
+            if not self._core.has_mesh() or self._stepped is None:
+                return float("inf")
+            # The masses of the spheres the mesh holds (even if bodies or wallIds changed since).
+            return self._guard.collective_limit(self._core, self._stepped.masses, yade.O.iter)
 
     @property
     def collective_viscous_history(self) -> list[dict[str, Any]]:
@@ -286,85 +409,110 @@ class FlowEngine(PyRunner):
     def critical_time_step(self) -> float:
         """min(dt_MV, collective viscous limit, DEM P-wave limit): O.dt should not exceed
         time_step_safety times this."""
-        scan = self._scanned()
-        return min(self.viscous_time_step, self.collective_viscous_time_step, scan.dt_dem)
+        with self._lock:
+            scan = self._scanned()
+            return min(self.viscous_time_step, self.collective_viscous_time_step, scan.dt_dem)
 
-    def _check_time_step(self, dt: float) -> None:
-        """Warn or raise (strict_time_step) if dt exceeds time_step_safety * critical_time_step."""
-        dt_mv = self.viscous_time_step
-        self._guard.check(dt, dt_mv, self.collective_viscous_time_step, self._scan.dt_dem)
+    def _check_time_step(self, dt: float, scan: SceneScan | None = None, collective: float | None = None) -> None:
+        """Warn or raise (strict_time_step) if dt exceeds time_step_safety * critical_time_step,
+        with the single-particle and DEM limits of `scan` (None: the current scan) and the given
+        collective limit (None: that of the current mesh, computed if needed)."""
+        if scan is None:
+            scan = self._scanned()
+        dt_mv = viscous_time_step(scan.mass_per_diameter, self._core.viscosity)
+        if collective is None:
+            collective = self.collective_viscous_time_step
+        self._guard.check(dt, dt_mv, collective, scan.dt_dem)
 
     def emulateAction(self) -> None:
         """Run one flow step outside the time-stepping loop, as YADE's method does."""
         self._step()
 
     # -- boundary conditions --------------------------------------------------------------
+    @_exclusive
     def updateBCs(self) -> None:
         """Apply changed boundary values and types (PFV applies values at every step anyway)."""
         self._core.request_system_rebuild()
 
+    @_exclusive
     def imposePressure(self, pos: Sequence[float], p: float) -> int:
-        """Impose pressure p in the cell containing pos; returns the condition's index."""
-        return self._core.impose_pressure(tuple(pos), float(p))
+        """Impose pressure p in the cell containing pos; returns the condition's index. A point
+        outside the pore space is refused (at once once there is a mesh, else at the first step)."""
+        return self._core.impose_pressure(attributes.as_point("imposePressure position", pos),
+                                          attributes.as_number("imposePressure pressure", p))
 
+    @_exclusive
     def setImposedPressure(self, cond: int, p: float) -> None:
         """Change the pressure of the imposed condition number cond."""
-        self._core.set_imposed_pressure(int(cond), float(p))
+        self._core.set_imposed_pressure(int(cond), attributes.as_number("setImposedPressure pressure", p))
 
+    @_exclusive
     def clearImposedPressure(self) -> None:
         self._core.clear_imposed_pressure()
 
+    @_exclusive
     def imposeFlux(self, pos: Sequence[float], p: float) -> None:
-        """YADE's sign: outflux positive, influx negative."""
-        self._core.impose_flux(tuple(pos), -float(p))
+        """YADE's sign: outflux positive, influx negative. A point outside the pore space is refused."""
+        self._core.impose_flux(attributes.as_point("imposeFlux position", pos),
+                               -attributes.as_number("imposeFlux flux", p))
 
+    @_exclusive
     def clearImposedFlux(self) -> None:
         self._core.clear_imposed_flux()
 
-    # -- queries ----------------------------------------------------------------------------
+    # -- queries: each waits for a step in progress on YADE's simulation thread -------------
     def _require_mesh(self) -> None:
-        if not self._core.has_mesh():
+        if not self._core.has_mesh() or self._stepped is None:
             raise RuntimeError("the flow engine has not run yet: no pore mesh (run at least one step)")
 
     def _cell_at(self, pos: Sequence[float]) -> int:
         self._require_mesh()
-        cell = self._core.locate(tuple(float(x) for x in pos))
+        cell = self._core.locate(attributes.as_point("position", pos))
         if cell < 0:
             raise ValueError(f"point {tuple(pos)} lies in no pore cell (outside the walls or the packing)")
         return cell
 
     def _vertex_of(self, body_id: int) -> int:
         self._require_mesh()
-        v = self._scan.vertex_of_id.get(int(body_id))
+        v = self._stepped.vertex_of_id.get(int(body_id))
         if v is None:
             raise ValueError(f"body {body_id} is not coupled with the fluid (not a sphere nor a wall)")
         return v
 
+    @_exclusive
     def getPorePressure(self, pos: Sequence[float]) -> float:
         return self._core.cell_pressure(self._cell_at(pos))
 
+    @_exclusive
     def getCell(self, X: float, Y: float, Z: float) -> int:
         self._require_mesh()
-        return self._core.locate((float(X), float(Y), float(Z)))
+        return self._core.locate(attributes.as_point("getCell position", (X, Y, Z)))
 
+    @_exclusive
     def getCellPressure(self, id: int) -> float:
         return self._core.cell_pressure(int(id))
 
+    @_exclusive
     def getCellCenter(self, id: int) -> Vector3:
         return Vector3(*self._core.cell_center(int(id)))
 
+    @_exclusive
     def getCellVolume(self, pos: Sequence[float]) -> float:
         return self._core.cell_volume(self._cell_at(pos))
 
+    @_exclusive
     def getBoundaryFlux(self, boundary: int) -> float:
         self._require_mesh()
-        if boundary not in self._wall_ids:
-            raise ValueError(f"body {boundary} is not one of the boundaries wallIds = {self._wall_ids}")
-        return self._core.boundary_flux(self._wall_ids.index(boundary))
+        wall_ids = self._stepped.wall_ids  # those of the last step, if wallIds changed since
+        if boundary not in wall_ids:
+            raise ValueError(f"body {boundary} is not one of the boundaries wallIds = {wall_ids}")
+        return self._core.boundary_flux(wall_ids.index(boundary))
 
+    @_exclusive
     def fluidForce(self, idSph: int) -> Vector3:
         return Vector3(*self._core.forces()[self._vertex_of(idSph)])
 
+    @_exclusive
     def shearLubForce(self, idSph: int) -> Vector3:
         """The viscous shear part of fluidForce(idSph) (viscousShear; zero while it is off).
         YADE's name: its shearLubForce reports the viscousShear force as well."""
@@ -372,17 +520,21 @@ class FlowEngine(PyRunner):
         shear = self._core.shear_forces()
         return Vector3(*shear[v]) if len(shear) else Vector3(0, 0, 0)
 
+    @_exclusive
     def nCells(self) -> int:
         return self._core.n_cells()
 
+    @_exclusive
     def averagePressure(self) -> float:
         self._require_mesh()
         return self._core.average_pressure()
 
+    @_exclusive
     def averageSlicePressure(self, posY: float, axis: int = 1) -> float:
         self._require_mesh()
-        return self._core.average_slice_pressure(int(axis), float(posY))
+        return self._core.average_slice_pressure(int(axis), attributes.as_number("averageSlicePressure position", posY))
 
+    @_exclusive
     def metisUsed(self) -> bool:
         return self._core.metis_used()
 

@@ -28,8 +28,8 @@ void FlowEngine::release() {
   pending_.reset();
   mesh_.reset();
   linear_ = LinearSystem{};
-  for (auto* v : {&pressure_, &volume_, &volume_rate_, &rhs_, &solution_, &next_volume_, &next_pressure_,
-                  &pressure_before_})
+  for (auto* v :
+       {&pressure_, &volume_, &volume_rate_, &rhs_, &solution_, &next_volume_, &next_pressure_, &pressure_before_})
     std::vector<double>().swap(*v);
   for (auto* v : {&force_, &next_force_, &shear_force_, &next_shear_, &centres_prev_}) std::vector<Vec3>().swap(*v);
   has_prev_ = keep_trend_ = false;

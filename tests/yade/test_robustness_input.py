@@ -72,6 +72,17 @@ expect_error("bndCondIsPressure of 5", ValueError, "6 values", lambda: setattr(f
 rb.check("settings unchanged by the refusals", flow.tolerance == 1e-6 and flow.maxKdivKmean == 100.0
          and flow.bndCondIsPressure == [False, False, True, True, False, False] and flow.wallIds == list(range(6)))
 
+# An iterative solve stopped by its iteration cap says so.
+gs = rb.fresh(useSolver=0)
+gs.core.max_iterations = 3
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    rb.run(2)
+capped = [w for w in caught if "not converged" in str(w.message)]
+rb.check("an unconverged Gauss-Seidel solve warns, once", len(capped) == 1 and not gs.core.converged)
+flow = rb.fresh()
+rb.run(1)
+
 # 3. Queries out of range.
 expect_error("fluidForce(10**6)", ValueError, "not coupled", lambda: flow.fluidForce(10 ** 6))
 expect_error("getCellPressure(10**9)", IndexError, "no pore cell", lambda: flow.getCellPressure(10 ** 9))

@@ -447,6 +447,8 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("cg_iterations",
                              exclusive([](const SharedEngine& e) { return e.last_solve().cg_iterations; }),
                              "Conjugate-gradient iterations of the last solve.")
+      .def_property_readonly("converged", exclusive([](const SharedEngine& e) { return e.last_solve().converged; }),
+                             "False if the last solve was iterative and stopped at max_iterations above its tolerance.")
       .def_property_readonly("refinement_passes",
                              exclusive([](const SharedEngine& e) { return e.last_solve().refinement_passes; }),
                              "Refinement passes of the last solve with a 32-bit factor.")

@@ -345,6 +345,11 @@ class FlowEngine(PyRunner):
             # A new mesh (the first, or a remesh adopted by this step) or new conductances: its
             # collective limit may be lower (a compacting sample), check again.
             self._check_time_step(scene.dt, scan)
+        if not core.converged and "unconverged" not in self._warned:
+            self._warned.add("unconverged")
+            warnings.warn(f"pfv.FlowEngine: at iteration {scene.iter} the {core.solver.replace('_', ' ')} solve "
+                          f"stopped at {core.max_iterations} iterations above tolerance = {core.tolerance:g}; "
+                          "the pressures are not converged (raise the tolerance or use useSolver=3)", stacklevel=2)
         if core.inversion_remeshes != inversions and "inverted" not in self._warned:
             self._warned.add("inverted")
             warnings.warn(f"pfv.FlowEngine: at iteration {scene.iter} spheres had moved so far since the last "

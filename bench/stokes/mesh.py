@@ -104,7 +104,7 @@ def build(packing, h, surface_factor=0.5, gap_factor=0.15, gap_ball=0.02, order=
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 10)  # HXT
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay: deterministic
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.model.mesh.generate(3)
         if order > 1:

@@ -20,7 +20,6 @@ def run(packing, variant, dp=1.0, mu=1.0):
     e.viscosity = mu
     e.slip_boundary = variant != "noslip"
     e.yade_wall_throat_factor = variant == "slip_yade"
-    e.clamp_k_values = False
     e.bnd_is_pressure = [False, False, True, True, False, False]
     e.bnd_value = [0.0, 0.0, dp, 0.0, 0.0, 0.0]
     e.step(centres, radii, WALLS, 1.0)

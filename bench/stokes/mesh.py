@@ -2,7 +2,8 @@
 
 The fluid is the cube minus the union of the spheres. Facet markers: the six faces of the cube
 1..6 in the order xmin, xmax, ymin, ymax, zmin, zmax, and sphere k as SPHERE_TAG + k. The element
-size is ``h`` in the bulk, ``h * surface_factor`` on the spheres, and ``h * gap_factor`` within a
+size is ``h`` in the bulk, ``h * surface_factor`` on the spheres (at most 0.6 r on a sphere of
+radius r), and ``h * gap_factor`` within a
 ball around each near-contact (sphere-sphere or sphere-wall gap below ``gap_ball`` l0), so the
 narrow gaps left by the shrink are resolved by a few elements.
 """
@@ -88,6 +89,16 @@ def build(packing, h, surface_factor=0.5, gap_factor=0.15, gap_ball=0.02, order=
         field.setNumber(near, "DistMin", 0.0)
         field.setNumber(near, "DistMax", 2.0 * h)
         fields = [near]
+        for c, r in zip(centres, radii):  # small spheres: elements of at most 0.6 r on and near them
+            if 0.6 * r < h * surface_factor:
+                ball = field.add("Ball")
+                for key, value in zip(("XCenter", "YCenter", "ZCenter"), c):
+                    field.setNumber(ball, key, value)
+                field.setNumber(ball, "Radius", 1.5 * r)
+                field.setNumber(ball, "Thickness", r)
+                field.setNumber(ball, "VIn", 0.6 * r)
+                field.setNumber(ball, "VOut", h)
+                fields.append(ball)
         for p in _contact_points(centres, radii, gap_ball):
             ball = field.add("Ball")
             field.setNumber(ball, "XCenter", p[0])

@@ -81,7 +81,7 @@ def fem_case(packing, h, laterals=("symmetry", "noslip")):
     return out
 
 
-def run_case(name, levels, with_yade=True, log=print):
+def run_case(name, levels, with_yade=True, log=print, save=lambda r: None):
     packing = case_packing(name)
     result = {"case": name, "n": len(packing["radii"]), "shrink": packing["shrink"],
               "porosity": packings.porosity(packing), "fem": [], "pfv": {}, "yade": None}
@@ -92,6 +92,7 @@ def run_case(name, levels, with_yade=True, log=print):
     for h in levels:
         level = fem_case(packing, h)
         result["fem"].append(level)
+        save(result)
         log("%-22s h %.3f  dofs %8d  kappa sym %.5e  noslip %.5e  mesh %.0f s  solve %.0f + %.0f s" % (
             name, h, level["symmetry"]["dofs"], level["symmetry"]["kappa"], level["noslip"]["kappa"],
             level["seconds_mesh"], level["symmetry"]["seconds_solve"], level["noslip"]["seconds_solve"]))
@@ -164,11 +165,15 @@ def main():
             results = json.load(f)
     for name in args.cases.split(","):
         start = time.perf_counter()
-        r = run_case(name, levels, with_yade=not args.no_yade)
-        r["seconds"] = time.perf_counter() - start
+
+        def save(r):
+            r["seconds"] = time.perf_counter() - start
+            with open(args.out, "w") as f:
+                json.dump([x for x in results if x["case"] != name] + [r], f, indent=1)
+
+        r = run_case(name, levels, with_yade=not args.no_yade, save=save)
+        save(r)
         results = [x for x in results if x["case"] != name] + [r]
-        with open(args.out, "w") as f:
-            json.dump(results, f, indent=1)
         print("%s done in %.0f s" % (name, r["seconds"]), flush=True)
     return 0
 

@@ -102,6 +102,8 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0):
             for key, form in zip(("pressure", "viscous"), forms):
                 parts[key].append(mesh.comm.allreduce(fem.assemble_scalar(form), op=MPI.SUM))
         forces[name] = parts
+    for obj in (ksp, A, b):  # MUMPS' factor is freed here, not when Python collects it
+        obj.destroy()
     return {
         "lateral": lateral,
         "flux_in": q_in, "flux_out": q_out,

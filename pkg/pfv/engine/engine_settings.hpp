@@ -11,6 +11,11 @@ namespace pfv {
 struct EngineSettings {
   ConductanceModel conductance;
   bool slip_boundary = true;
+  // With slip_boundary only: multiply R_h of every throat with one wall vertex by 2^-1/4 and with
+  // two or three by 2^-1/2 before its conductance is computed, as YADE 2023.02a does
+  // (conductance x 0.71 and x 0.5). Not in the thesis, and further from Stokes flow
+  // (doc/validation.md section 7); for matching results of YADE's engine.
+  bool yade_wall_throat_factor = false;
   SolverKind solver = SolverKind::kCholesky;
   double tolerance = 1e-6;  // iterative solvers
   double relax = 1.9;       // Gauss-Seidel

@@ -20,9 +20,13 @@ struct MeshRecipe {
   ConductanceModel conductance;
   bool slip_boundary = true;
   bool viscous_shear = false;
+  bool yade_wall_throat_factor = false;
 
   explicit MeshRecipe(const EngineSettings& s)
-      : conductance(s.conductance), slip_boundary(s.slip_boundary), viscous_shear(s.viscous_shear) {}
+      : conductance(s.conductance),
+        slip_boundary(s.slip_boundary),
+        viscous_shear(s.viscous_shear),
+        yade_wall_throat_factor(s.yade_wall_throat_factor) {}
   // Whether a mesh built from this recipe must be rebuilt for 's'. The viscosity is not
   // compared: every conductance is inversely proportional to it (the clamp is relative to the
   // median), so a change rescales them (PoreMesh::set_viscosity) without a new triangulation.

@@ -15,6 +15,7 @@
 
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
+#include "pfv/model/force_parts.hpp"
 #include "pfv/python/yade_force_bridge.hpp"
 #include "pfv/python/yade_sphere_pack.hpp"
 #include "pfv/snapshot/snapshot.hpp"
@@ -255,6 +256,10 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&ConductanceModel::max_ratio))
       .def_property("slip_boundary", get_setting(&EngineSettings::slip_boundary),
                     set_setting(&EngineSettings::slip_boundary))
+      .def_property("yade_wall_throat_factor", get_setting(&EngineSettings::yade_wall_throat_factor),
+                    set_setting(&EngineSettings::yade_wall_throat_factor),
+                    "With slip_boundary: YADE's factor on R_h of wall throats (2^-1/4 with one wall vertex, 2^-1/2 "
+                    "with two), off by default; remeshes at the next step.")
       .def_property("solver",
                     exclusive([](const SharedEngine& e) { return std::string(to_string(e.settings.solver)); }),
                     exclusive([](SharedEngine& e, const std::string& v) {
@@ -387,6 +392,18 @@ PYBIND11_MODULE(_core, m) {
            "the estimated eigenvector, applications the operator applications made (each a solve).")
       .def("forces", exclusive([](const SharedEngine& e) { return points_to_array(e.forces()); }),
            "Fluid force on every sphere (input order), then on the six walls.")
+      .def("force_parts",
+           exclusive([](const SharedEngine& e, const Array& centres, const Array& radii,
+                        const std::array<double, 6>& walls) {
+             const auto c = to_points(centres, "positions");
+             const auto r = to_vector(radii, "radii");
+             const BoxWalls w = to_walls(walls);
+             const ForceParts parts = split_fluid_forces(meshed(e).mesh(), e.facets(), Packing{c, r, w}, e.pressure());
+             return py::make_tuple(points_to_array(parts.pressure), points_to_array(parts.viscous));
+           }),
+           py::arg("positions"), py::arg("radii"), py::arg("walls"),
+           "(pressure, viscous): forces() without the shear term, split into its pressure and viscous parts\n"
+           "(spheres, then the six walls), for the packing of the last step (pass the same arrays).")
       .def("shear_forces", exclusive([](const SharedEngine& e) { return points_to_array(e.shear_forces()); }),
            "The viscous shear part of forces() (empty while viscous_shear is off).")
       .def("shear_pairs", exclusive([](const SharedEngine& e) {

@@ -41,6 +41,7 @@ CORE_NAME: dict[str, str] = {
     "mixed_precision": "mixed_precision",
     "mixed_precision_min_entries": "mixed_precision_min_entries",
     "refinement_tolerance": "refinement_tolerance",
+    "yade_wall_throat_factor": "yade_wall_throat_factor",
 }
 
 # YADE's useSolver numbers and the core's solver names (YADE's 2, Taucs, has no counterpart).

@@ -1,0 +1,209 @@
+"""Tables and figure of the Stokes comparison from run.py's JSON (doc/validation.md section 7).
+
+    /usr/bin/python3 bench/stokes/report.py [--results=FILE] [--figure=doc/figures/stokes-kappa.png]
+
+Prints Markdown: the mesh-convergence table of every case, the permeability table (FEM at the
+finest mesh, its Richardson estimate, PFV's three wall variants and YADE's engine, with the
+ratios to FEM), and the force table of the 9-sphere packing at d/D = 0.72 beside thesis
+Table 3.2. The figure plots kappa_PFV / kappa_FEM against d/D and per packing.
+"""
+import argparse
+import json
+import os
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+# thesis Table 3.2 (no-slip lateral faces, forces / (S dP)): FEM, PFV
+THESIS_TABLE_3_2 = {
+    "big sphere, viscous y": (1.51e-2, 1.06e-2), "big sphere, pressure y": (9.09e-2, 9.64e-2),
+    "big sphere, total y": (1.06e-1, 1.07e-1), "small sphere, viscous y": (9.38e-3, 5.83e-3),
+    "small sphere, pressure y": (5.17e-2, 5.72e-2), "small sphere, total y": (6.04e-2, 6.30e-2),
+    "boundary x=0, viscous y": (2.27e-2, 2.03e-2), "boundary x=0, pressure x": (4.98e-1, 5.00e-1),
+    "solid phase, total y": (1 - 5.56e-4, 1 + 1.18e-4),
+}
+
+
+def fem_estimate(levels, lateral):
+    """(finest kappa, change from the previous level, Richardson estimate with the observed order)."""
+    k = [lv[lateral]["kappa"] for lv in levels]
+    h = [lv["h"] for lv in levels]
+    if len(k) < 2:
+        return k[-1], float("nan"), float("nan")
+    change = k[-1] / k[-2] - 1
+    extrapolated = float("nan")
+    if len(k) >= 3 and (k[-2] - k[-3]) != 0 and (k[-1] - k[-2]) / (k[-2] - k[-3]) > 0:
+        ratio = (k[-1] - k[-2]) / (k[-2] - k[-3])
+        order = np.log(ratio) / np.log(h[-1] / h[-2]) if h[-1] / h[-2] != 1 else float("nan")
+        if order > 0.5:
+            extrapolated = k[-1] + (k[-1] - k[-2]) / ((h[-2] / h[-1]) ** order - 1)
+    return k[-1], change, extrapolated
+
+
+def convergence_table(results):
+    lines = ["| case | h | DOFs | κ_FEM sym | change | κ_FEM no-slip | change | solve (s) sym / no-slip |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        prev = None
+        for lv in r["fem"]:
+            s, n = lv["symmetry"], lv["noslip"]
+            cs = "" if prev is None else "%+.2f %%" % (100 * (s["kappa"] / prev[0] - 1))
+            cn = "" if prev is None else "%+.2f %%" % (100 * (n["kappa"] / prev[1] - 1))
+            lines.append("| %s | %.3f | %d | %.4e | %s | %.4e | %s | %.0f / %.0f |" % (
+                r["case"], lv["h"], s["dofs"], s["kappa"], cs, n["kappa"], cn, s["seconds_solve"], n["seconds_solve"]))
+            prev = (s["kappa"], n["kappa"])
+    return "\n".join(lines)
+
+
+def yade_kappa(r, variant):
+    y = r.get("yade") or {}
+    v = (y.get(variant) or {}).get("kappa")
+    return float("nan") if v is None else v
+
+
+def kappa_rows(results):
+    rows = []
+    for r in results:
+        ks, _, es = fem_estimate(r["fem"], "symmetry")
+        kn, _, en = fem_estimate(r["fem"], "noslip")
+        rows.append({
+            "case": r["case"], "n": r["n"], "porosity": r["porosity"],
+            # the reference: the Richardson estimate where three levels give one, else the finest mesh
+            "fem_sym": es if np.isfinite(es) else ks, "fem_noslip": en if np.isfinite(en) else kn,
+            "fem_sym_finest": ks, "fem_noslip_finest": kn,
+            "pfv_noslip": r["pfv"]["noslip"]["kappa"], "pfv_slip": r["pfv"]["slip"]["kappa"],
+            "pfv_slip_yade": r["pfv"]["slip_yade"]["kappa"],
+            "yade_noslip": yade_kappa(r, "noslip"), "yade_slip": yade_kappa(r, "slip")})
+    return rows
+
+
+def kappa_table(rows):
+    lines = ["| case | porosity | κ_FEM sym | PFV slip, thesis / FEM | PFV slip, YADE factor / FEM "
+             "| YADE slip / FEM | κ_FEM no-slip | PFV no-slip / FEM | YADE no-slip / FEM |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for w in rows:
+        sym, ns = w["fem_sym"], w["fem_noslip"]
+        lines.append("| %s | %.3f | %.4e | **%.3f** | %.3f | %.3f | %.4e | %.3f | %.3f |" % (
+            w["case"], w["porosity"], sym, w["pfv_slip"] / sym, w["pfv_slip_yade"] / sym, w["yade_slip"] / sym,
+            ns, w["pfv_noslip"] / ns, w["yade_noslip"] / ns))
+    return "\n".join(lines)
+
+
+def summary(rows):
+    main = [w for w in rows if "@" not in w["case"]]
+    out = []
+    for key, ref, label in (("pfv_slip", "fem_sym", "PFV slip, thesis formula"),
+                            ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor"),
+                            ("yade_slip", "fem_sym", "YADE slip"),
+                            ("pfv_noslip", "fem_noslip", "PFV no-slip"),
+                            ("yade_noslip", "fem_noslip", "YADE no-slip")):
+        q = np.array([w[key] / w[ref] for w in main])
+        q = q[np.isfinite(q)]
+        if len(q):
+            worst = q[np.argmax(np.abs(q - 1))]
+            out.append("| %s | %.3f | %.3f | %.3f | %d |" % (
+                label, q.mean(), np.exp(np.mean(np.log(q))), worst, len(q)))
+    return "\n".join(["| κ / κ_FEM | mean | geometric mean | furthest from 1 | cases |", "|---|---|---|---|---|"] + out)
+
+
+def forces_072(results):
+    r = next((x for x in results if x["case"] == "centred9_0.72"), None)
+    if r is None:
+        return ""
+    fem = r["fem"][-1]["noslip"]["forces"]
+    pfv = r["pfv"]["noslip"]["forces"]
+
+    def parts(f, name, part, axis):
+        if part == "total":
+            return f[name]["pressure"][axis] + f[name]["viscous"][axis]
+        return f[name][part][axis]
+
+    def big(f, part):
+        return np.mean([parts(f, "sphere%d" % k, part, 1) for k in range(8)])
+
+    def solid(f):
+        solids = [k for k in f if k.startswith("sphere") or k in ("xmin", "xmax", "zmin", "zmax")]
+        return sum(parts(f, k, "total", 1) for k in solids)
+
+    ours = {
+        "big sphere, viscous y": (big(fem, "viscous"), big(pfv, "viscous")),
+        "big sphere, pressure y": (big(fem, "pressure"), big(pfv, "pressure")),
+        "big sphere, total y": (big(fem, "total"), big(pfv, "total")),
+        "small sphere, viscous y": (parts(fem, "sphere8", "viscous", 1), parts(pfv, "sphere8", "viscous", 1)),
+        "small sphere, pressure y": (parts(fem, "sphere8", "pressure", 1), parts(pfv, "sphere8", "pressure", 1)),
+        "small sphere, total y": (parts(fem, "sphere8", "total", 1), parts(pfv, "sphere8", "total", 1)),
+        "boundary x=0, viscous y": (parts(fem, "xmin", "viscous", 1), parts(pfv, "xmin", "viscous", 1)),
+        "boundary x=0, pressure x": (-parts(fem, "xmin", "pressure", 0), -parts(pfv, "xmin", "pressure", 0)),
+        "solid phase, total y": (solid(fem), solid(pfv)),
+    }
+    lines = ["| force / (S ΔP) | FEM (here) | PFV (here) | PFV / FEM | thesis FEM | thesis PFV "
+             "| thesis PFV / FEM |",
+             "|---|---|---|---|---|---|---|"]
+    for name, (f, p) in ours.items():
+        tf, tp = THESIS_TABLE_3_2[name]
+        lines.append("| %s | %.4g | %.4g | %.3f | %.4g | %.4g | %.3f |" % (name, f, p, p / f, tf, tp, tp / tf))
+    return "\n".join(lines)
+
+
+def figure(rows, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    series = sorted([w for w in rows if w["case"].startswith("centred9_") and "@" not in w["case"]],
+                    key=lambda w: float(w["case"].split("_")[1]))
+    x = [float(w["case"].split("_")[1]) for w in series]
+    styles = (("pfv_slip", "fem_sym", "PFV slip, thesis formula", "o-"),
+              ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor", "s--"),
+              ("yade_slip", "fem_sym", "YADE slip", "x:"),
+              ("pfv_noslip", "fem_noslip", "PFV no-slip", "^-"),
+              ("yade_noslip", "fem_noslip", "YADE no-slip", "+:"))
+    for key, ref, label, style in styles:
+        a.plot(x, [w[key] / w[ref] for w in series], style, label=label)
+    a.axhline(1, color="k", lw=0.5)
+    a.set_xlabel("d/D (9-sphere packing)")
+    a.set_ylabel("κ / κ_FEM (same lateral condition)")
+    a.legend(fontsize=8)
+    packs = [w for w in rows if not w["case"].startswith("centred9_") and "@" not in w["case"]]
+    packs.append(next(w for w in rows if w["case"] == "centred9_0.72"))
+    names = [w["case"].replace("centred9_0.72", "9 (d/D 0.72)").replace("cubic8", "8").replace("random", "")
+             for w in packs]
+    pos = np.arange(len(packs))
+    for i, (key, ref, label, style) in enumerate(styles):
+        b.plot(pos + (i - 2) * 0.06, [w[key] / w[ref] for w in packs], style[0], label=label)
+    b.axhline(1, color="k", lw=0.5)
+    b.set_xticks(pos)
+    b.set_xticklabels(names)
+    b.set_xlabel("packing (number of spheres)")
+    b.set_ylabel("κ / κ_FEM")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--results", default=",".join(os.path.join(HERE, "results", f)
+                                                  for f in ("stokes_results.json", "stokes_series.json")))
+    ap.add_argument("--figure", default=os.path.join(ROOT, "doc", "figures", "stokes-kappa.png"))
+    args = ap.parse_args()
+    results = {}
+    for path in args.results.split(","):
+        if os.path.exists(path):
+            with open(path) as f:
+                results.update({r["case"]: r for r in json.load(f)})
+    order = ["cubic8", "centred9_0.72", "random25", "random54"]
+    results = sorted(results.values(), key=lambda r: (order.index(r["case"]) if r["case"] in order else 9, r["case"]))
+    rows = kappa_rows(results)
+    print("## convergence\n\n" + convergence_table(results))
+    print("\n## permeability\n\n" + kappa_table(rows))
+    print("\n## summary\n\n" + summary(rows))
+    print("\n## forces, 9 spheres, d/D = 0.72, no-slip\n\n" + forces_072(results))
+    if any(w["case"].startswith("centred9_") for w in rows):
+        figure(rows, args.figure)
+        print("\nfigure:", args.figure)
+
+
+if __name__ == "__main__":
+    main()

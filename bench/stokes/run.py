@@ -1,0 +1,182 @@
+"""Stokes (FEM) against PFV and YADE on the thesis' frozen packings (section 3.5): the driver.
+
+    /usr/bin/python3 bench/stokes/run.py [--cases=a,b] [--levels=0.16,0.12,0.09] [--out=FILE]
+    /usr/bin/python3 bench/stokes/run.py --quick [--write-reference]
+
+Needs the pfv package on PYTHONPATH (a build tree's python/ folder) and, for the YADE column,
+yade-double on PATH. For every case and every mesh size h of --levels it solves Stokes flow with
+symmetry and with no-slip lateral faces (solve.py), then runs PFV (no-slip walls, slip walls with
+the thesis' formula, slip walls with YADE's factor; pfv_model.py) and YADE's engine
+(yade_model.py) on the same spheres. Results are appended case by case to --out (JSON).
+
+--quick runs the CI case: the 8-sphere packing on one coarse mesh; with --write-reference it
+writes tests/data/stokes_fem_quick.json, else it compares with that file and exits 1 on a
+difference larger than its tolerances.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+import mesh as fem_mesh  # noqa: E402
+import packings  # noqa: E402
+import pfv_model  # noqa: E402
+import solve  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(HERE))
+REFERENCE = os.path.join(ROOT, "tests", "data", "stokes_fem_quick.json")
+SHRINK = 0.01
+QUICK_H = 0.2
+D_OVER_D = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.72, 0.8)
+
+
+def case_packing(name):
+    if name == "cubic8":
+        p = packings.cubic8()
+    elif name.startswith("centred9_"):
+        p = packings.centred9(float(name.split("_")[1]))
+    elif name.startswith("random"):
+        p = packings.load(os.path.join(HERE, "data", name + ".json"))
+    else:
+        raise ValueError("unknown case " + name)
+    shrink = SHRINK
+    if "@" in name:
+        shrink = float(name.split("@")[1])
+    return packings.shrunk(p, shrink)
+
+
+def all_cases():
+    return ["cubic8", "centred9_0.72", "random25", "random54"] + \
+        ["centred9_%.2f" % x for x in D_OVER_D if x != 0.72] + ["cubic8@0.005", "centred9_0.72@0.005"]
+
+
+def run_yade(packing):
+    with tempfile.TemporaryDirectory() as tmp:
+        src, dst = os.path.join(tmp, "packing.json"), os.path.join(tmp, "yade.json")
+        packings.save(packing, src)
+        env = dict(os.environ, OMP_NUM_THREADS="1")
+        done = subprocess.run(["yade-double", "-n", "-x", os.path.join(HERE, "yade_model.py"), src, dst],
+                              env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if done.returncode != 0 or not os.path.exists(dst):
+            return {"error": done.stdout[-2000:]}
+        with open(dst) as f:
+            return json.load(f)
+
+
+def fem_case(packing, h, laterals=("symmetry", "noslip")):
+    start = time.perf_counter()
+    msh, _, facets = fem_mesh.build(packing, h)
+    meshed = time.perf_counter() - start
+    out = {"h": h, "seconds_mesh": meshed}
+    for lateral in laterals:
+        out[lateral] = solve.solve(msh, facets, len(packing["radii"]), lateral)
+    return out
+
+
+def run_case(name, levels, with_yade=True, log=print, save=lambda r: None):
+    packing = case_packing(name)
+    result = {"case": name, "n": len(packing["radii"]), "shrink": packing["shrink"],
+              "porosity": packings.porosity(packing), "fem": [], "pfv": {}, "yade": None}
+    for variant in pfv_model.VARIANTS:
+        result["pfv"][variant] = pfv_model.run(packing, variant)
+    if with_yade:
+        result["yade"] = run_yade(packing)
+    for h in levels:
+        level = fem_case(packing, h)
+        result["fem"].append(level)
+        save(result)
+        log("%-22s h %.3f  dofs %8d  kappa sym %.5e  noslip %.5e  mesh %.0f s  solve %.0f + %.0f s" % (
+            name, h, level["symmetry"]["dofs"], level["symmetry"]["kappa"], level["noslip"]["kappa"],
+            level["seconds_mesh"], level["symmetry"]["seconds_solve"], level["noslip"]["seconds_solve"]))
+    return result
+
+
+def quick_numbers():
+    """The CI case: 8 spheres, one coarse mesh, both lateral conditions; FEM and PFV."""
+    r = run_case("cubic8", [QUICK_H], with_yade=False, log=lambda *a: None)
+    fem = r["fem"][0]
+    out = {"h": QUICK_H, "shrink": SHRINK}
+    for lateral in ("symmetry", "noslip"):
+        s = fem[lateral]
+        fy = [s["forces"]["sphere%d" % k]["pressure"][1] + s["forces"]["sphere%d" % k]["viscous"][1]
+              for k in range(8)]
+        balance = abs(s["flux_in"] - s["flux_out"]) / s["flux_in"]
+        out[lateral] = {"kappa": s["kappa"], "dofs": s["dofs"], "flux_balance": balance,
+                        "sphere_force_y": float(np.mean(fy)), "sphere_force_spread": float(np.ptp(fy))}
+    out["pfv"] = {v: r["pfv"][v]["kappa"] for v in pfv_model.VARIANTS}
+    return out
+
+
+def compare_quick(now, ref):
+    """Rows (what, value, reference, ok). The FEM on the same mesh and solver: kappa and the mean
+    sphere force to 1e-6 relative; the flux balance of Taylor-Hood (not locally conservative) on
+    this coarse mesh below 1 %; PFV's kappa to 1e-9."""
+    rows = []
+    for lateral in ("symmetry", "noslip"):
+        a, b = now[lateral], ref[lateral]
+        rows.append(("FEM dofs, " + lateral, a["dofs"], b["dofs"], a["dofs"] == b["dofs"]))
+        rows.append(("FEM kappa, " + lateral, a["kappa"], b["kappa"], abs(a["kappa"] / b["kappa"] - 1) < 1e-6))
+        rows.append(("FEM mean sphere force, " + lateral, a["sphere_force_y"], b["sphere_force_y"],
+                     abs(a["sphere_force_y"] / b["sphere_force_y"] - 1) < 1e-6))
+        rows.append(("FEM |Q_in - Q_out| / Q_in, " + lateral, a["flux_balance"], 0.01, a["flux_balance"] < 0.01))
+    for v, k in now["pfv"].items():
+        rows.append(("PFV kappa, " + v, k, ref["pfv"][v], abs(k / ref["pfv"][v] - 1) < 1e-9))
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--cases", default=",".join(all_cases()))
+    ap.add_argument("--levels", default="0.16,0.12,0.09")
+    ap.add_argument("--out", default=os.path.join(HERE, "results", "stokes_results.json"))
+    ap.add_argument("--no-yade", action="store_true")
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--write-reference", action="store_true")
+    args = ap.parse_args()
+    if args.quick:
+        now = quick_numbers()
+        if args.write_reference:
+            with open(REFERENCE, "w") as f:
+                json.dump(now, f, indent=1)
+            print("wrote", REFERENCE)
+            return 0
+        with open(REFERENCE) as f:
+            ref = json.load(f)
+        rows = compare_quick(now, ref)
+        for what, value, expected, ok in rows:
+            print("%-45s %14.8g %14.8g  %s" % (what, value, expected, "ok" if ok else "FAIL"))
+        failed = sum(1 for r in rows if not r[3])
+        print("%d passed, %d failed" % (len(rows) - failed, failed))
+        return 1 if failed else 0
+
+    levels = [float(h) for h in args.levels.split(",")]
+    os.makedirs(os.path.dirname(args.out), exist_ok=True)
+    results = []
+    if os.path.exists(args.out):
+        with open(args.out) as f:
+            results = json.load(f)
+    for name in args.cases.split(","):
+        start = time.perf_counter()
+
+        def save(r):
+            r["seconds"] = time.perf_counter() - start
+            with open(args.out, "w") as f:
+                json.dump([x for x in results if x["case"] != name] + [r], f, indent=1)
+
+        r = run_case(name, levels, with_yade=not args.no_yade, save=save)
+        save(r)
+        results = [x for x in results if x["case"] != name] + [r]
+        print("%s done in %.0f s" % (name, r["seconds"]), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,117 @@
+"""Taylor-Hood (P2-P1) Stokes flow in the fluid mesh of mesh.py, solved by LU (MUMPS through PETSc).
+
+Pressure dp on the face y = 0 and 0 on y = 1 (natural condition sigma.n = -p n, with
+sigma = -p I + 2 mu eps(u)); no-slip on the spheres; on the four lateral faces either no-slip or
+symmetry (u.n = 0 with zero tangential traction). Returns the flux through both pressure faces,
+the permeability kappa = mu Q l0 / (dp S) with S = l0^2 (l0 = 1, so kappa is kappa / l0^2), and
+the force of the fluid on every sphere and lateral face, split into its pressure and viscous
+parts.
+"""
+import time
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from dolfinx.mesh import meshtags
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from mesh import FACES, SPHERE_TAG
+
+LATERAL = (1, 2, 5, 6)  # xmin, xmax, zmin, zmax: the flow is along y
+INLET, OUTLET = 3, 4
+
+
+def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0):
+    start = time.perf_counter()
+    cell = mesh.ufl_cell()
+    element = ufl.MixedElement([ufl.VectorElement("Lagrange", cell, 2), ufl.FiniteElement("Lagrange", cell, 1)])
+    W = fem.FunctionSpace(mesh, element)
+    fdim = mesh.topology.dim - 1
+    mesh.topology.create_connectivity(fdim, mesh.topology.dim)
+
+    def marked(markers):
+        return np.concatenate([facets.find(m) for m in markers]).astype(np.int32)
+
+    V, _ = W.sub(0).collapse()
+    zero = fem.Function(V)
+    walls = [SPHERE_TAG + k for k in range(n_spheres)]
+    if lateral == "noslip":
+        walls += list(LATERAL)
+    bcs = [fem.dirichletbc(zero, fem.locate_dofs_topological((W.sub(0), V), fdim, marked(walls)), W.sub(0))]
+    if lateral == "symmetry":
+        for axis, markers in ((0, (1, 2)), (2, (5, 6))):
+            sub = W.sub(0).sub(axis)
+            dofs = fem.locate_dofs_topological(sub, fdim, marked(markers))
+            bcs.append(fem.dirichletbc(PETSc.ScalarType(0), dofs, sub))
+    elif lateral != "noslip":
+        raise ValueError("lateral must be 'symmetry' or 'noslip'")
+
+    u, p = ufl.TrialFunctions(W)
+    v, q = ufl.TestFunctions(W)
+    ds = ufl.Measure("ds", domain=mesh, subdomain_data=facets)
+    n = ufl.FacetNormal(mesh)
+    eps = ufl.sym
+    a = (2 * mu * ufl.inner(eps(ufl.grad(u)), eps(ufl.grad(v))) - p * ufl.div(v) - q * ufl.div(u)) * ufl.dx
+    L = -dp * ufl.inner(n, v) * ds(INLET)
+
+    A = fem.petsc.assemble_matrix(fem.form(a), bcs=bcs)
+    A.assemble()
+    b = fem.petsc.assemble_vector(fem.form(L))
+    fem.petsc.apply_lifting(b, [fem.form(a)], bcs=[bcs])
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    fem.petsc.set_bc(b, bcs)
+    ksp = PETSc.KSP().create(MPI.COMM_SELF)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("lu")
+    pc.setFactorSolverType("mumps")
+    w = fem.Function(W)
+    assembled = time.perf_counter()
+    ksp.solve(b, w.vector)
+    w.x.scatter_forward()
+    solved = time.perf_counter()
+    uh, ph = w.split()
+
+    def integral(expr):
+        return mesh.comm.allreduce(fem.assemble_scalar(fem.form(expr)), op=MPI.SUM)
+
+    q_in = -integral(ufl.dot(uh, n) * ds(INLET))
+    q_out = integral(ufl.dot(uh, n) * ds(OUTLET))
+    flux = 0.5 * (q_in + q_out)
+    # force of the fluid on the solid: -sigma.n with n the outward normal of the fluid. One
+    # marker at a time is tagged 1 in its own MeshTags, so the forms compile once.
+    e = fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
+    dsk = ufl.Measure("ds", domain=mesh, subdomain_data=facets)
+
+    def part_forms(measure):
+        return (fem.form(ph * ufl.dot(n, e) * measure(1)),
+                fem.form(-2 * mu * ufl.dot(ufl.dot(eps(ufl.grad(uh)), n), e) * measure(1)))
+
+    forces = {}
+    for marker, name in [(SPHERE_TAG + k, "sphere%d" % k) for k in range(n_spheres)] + \
+            [(m, FACES[m - 1]) for m in LATERAL]:
+        tags = meshtags(mesh, fdim, np.sort(facets.find(marker)).astype(np.int32),
+                        np.ones(len(facets.find(marker)), dtype=np.int32))
+        dsk = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
+        forms = part_forms(dsk)
+        parts = {"pressure": [], "viscous": []}
+        for i in range(3):
+            e.value = np.eye(3)[i]
+            for key, form in zip(("pressure", "viscous"), forms):
+                parts[key].append(mesh.comm.allreduce(fem.assemble_scalar(form), op=MPI.SUM))
+        forces[name] = parts
+    for obj in (ksp, A, b):  # MUMPS' factor is freed here, not when Python collects it
+        obj.destroy()
+    return {
+        "lateral": lateral,
+        "flux_in": q_in, "flux_out": q_out,
+        "kappa": mu * flux / dp,  # l0 = 1, S = 1
+        "dofs": W.dofmap.index_map.size_global * W.dofmap.index_map_bs,
+        "velocity_dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
+        "cells": mesh.topology.index_map(3).size_global,
+        "seconds_assembly": assembled - start,
+        "seconds_solve": solved - assembled,
+        "forces": forces,
+    }

@@ -16,47 +16,16 @@
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/model/force_parts.hpp"
+#include "pfv/python/shared_engine.hpp"
 #include "pfv/python/yade_force_bridge.hpp"
 #include "pfv/python/yade_sphere_pack.hpp"
 #include "pfv/snapshot/snapshot.hpp"
 
 namespace py = pybind11;
 using namespace pfv;
+using namespace pfv::python;
 
 namespace {
-
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-std::vector<Vec3> to_points(const Array& a, const char* name) {
-  if (a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(std::string(name) + " must have shape (n, 3)");
-  std::vector<Vec3> out(a.shape(0));
-  static_assert(sizeof(Vec3) == 3 * sizeof(double));
-  if (!out.empty()) std::memcpy(static_cast<void*>(out.data()), a.data(), out.size() * sizeof(Vec3));
-  return out;
-}
-
-std::vector<double> to_vector(const Array& a, const char* name) {
-  if (a.ndim() != 1) throw py::value_error(std::string(name) + " must be one-dimensional");
-  return std::vector<double>(a.data(), a.data() + a.shape(0));
-}
-
-Array points_to_array(const std::vector<Vec3>& v) {
-  Array out({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
-  if (!v.empty()) std::memcpy(out.mutable_data(), v.data(), v.size() * sizeof(Vec3));
-  return out;
-}
-
-template <class T>
-py::array_t<T> vector_to_array(const std::vector<T>& v) {
-  return py::array_t<T>(static_cast<py::ssize_t>(v.size()), v.data());
-}
-
-BoxWalls to_walls(const std::array<double, 6>& w) {
-  BoxWalls b;
-  b.coord = w;
-  return b;
-}
-
 py::dict times_dict(const StageTimes& t) {
   py::dict d;
   d["triangulation"] = t.triangulation;
@@ -73,51 +42,6 @@ py::dict times_dict(const StageTimes& t) {
   d["shear_forces"] = t.shear_forces;
   d["total"] = t.total;
   return d;
-}
-
-// The engine as Python holds it. YADE runs O.run() on a thread of its own, so a query from the
-// main thread may arrive while a step rebuilds the mesh. Every call into the engine takes its
-// lock; a caller that must wait does so with the GIL released (a step releases the GIL while it
-// runs, and never needs it while it holds the lock), so the two threads cannot deadlock.
-struct SharedEngine : FlowEngine {
-  mutable std::mutex busy;
-};
-
-std::unique_lock<std::mutex> hold(const SharedEngine& e) {
-  std::unique_lock<std::mutex> lock(e.busy, std::try_to_lock);
-  if (!lock.owns_lock()) {
-    py::gil_scoped_release release;
-    lock.lock();
-  }
-  return lock;
-}
-
-// f(engine, args...) under the engine's lock, for a lambda taking the engine first ...
-template <class F, class R, class Self, class... A>
-auto exclusive_call(F f, R (F::*)(Self, A...) const) {
-  return [f = std::move(f)](Self e, A... a) -> R {
-    const auto lock = hold(e);
-    return f(e, std::forward<A>(a)...);
-  };
-}
-template <class F>
-auto exclusive(F f) {
-  return exclusive_call(std::move(f), &F::operator());
-}
-// ... or for a member function of the engine.
-template <class R, class... A>
-auto exclusive(R (FlowEngine::*m)(A...) const) {
-  return [m](const SharedEngine& e, A... a) -> R {
-    const auto lock = hold(e);
-    return (e.*m)(std::forward<A>(a)...);
-  };
-}
-template <class R, class... A>
-auto exclusive(R (FlowEngine::*m)(A...)) {
-  return [m](SharedEngine& e, A... a) -> R {
-    const auto lock = hold(e);
-    return (e.*m)(std::forward<A>(a)...);
-  };
 }
 
 // Applies an edit to a copy of the settings, validated by the core before it is kept.
@@ -167,20 +91,6 @@ int add_point_condition(FlowEngine& e, std::vector<PointCondition>& list, const 
                           " lies in no pore cell (outside the walls or the packing)");
   }
   return static_cast<int>(list.size()) - 1;
-}
-
-const FlowEngine& meshed(const FlowEngine& e) {
-  if (!e.has_mesh()) throw py::value_error("the engine has no pore mesh yet (run a step first)");
-  return e;
-}
-
-void check_cell(const FlowEngine& e, int id) {
-  meshed(e);
-  if (id < 0 || id >= e.mesh().n_cells()) throw py::index_error("no pore cell with index " + std::to_string(id));
-}
-
-void check_wall(int w) {
-  if (w < 0 || w >= kWallCount) throw py::index_error("wall index must be in 0..5");
 }
 
 }  // namespace
@@ -242,7 +152,8 @@ PYBIND11_MODULE(_core, m) {
     if (PyErr_Occurred()) throw py::error_already_set();
   });
 
-  py::class_<SharedEngine>(m, "Engine")
+  EngineClass engine(m, "Engine");
+  engine
       .def(py::init<>())
       // Settings: forwarded as they are; the core validates them (validate()) and decides at
       // the next step what a change makes stale.
@@ -472,19 +383,6 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("accumulated_strain", exclusive(&FlowEngine::accumulated_strain))
       .def("walls", exclusive([](const SharedEngine& e) { return e.walls().coord; }))
       .def("remesh_times", exclusive([](const SharedEngine& e) { return times_dict(e.remesh_times()); }))
-      .def("step_times", exclusive([](const SharedEngine& e) { return times_dict(e.step_times()); }))
-      // Geometry, for tests and post-processing.
-      .def("cell_vertices", exclusive([](const SharedEngine& e) {
-             const auto& cv = meshed(e).mesh().cell_vertices;
-             py::array_t<int> out({static_cast<py::ssize_t>(cv.size()), py::ssize_t{4}});
-             if (!cv.empty()) std::memcpy(out.mutable_data(), cv.data(), cv.size() * sizeof(cv[0]));
-             return out;
-           }))
-      .def("cell_volumes", exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).cells().volume); }))
-      .def("cell_fluid_volumes",
-           exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).cells().fluid_volume); }))
-      .def("cell_centers",
-           exclusive([](const SharedEngine& e) { return points_to_array(meshed(e).cells().power_centre); }))
-      .def("conductances", exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).conductances()); }))
-      .def("facet_cells", exclusive([](const SharedEngine& e) { return meshed(e).facets().cell; }));
+      .def("step_times", exclusive([](const SharedEngine& e) { return times_dict(e.step_times()); }));
+  bind_geometry(engine);
 }

@@ -1,0 +1,27 @@
+// Geometry of the current mesh, for tests and post-processing (numpy copies).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "pfv/python/shared_engine.hpp"
+
+namespace pfv::python {
+
+void bind_geometry(EngineClass& engine) {
+  engine
+      .def("cell_vertices", exclusive([](const SharedEngine& e) {
+             const auto& cv = meshed(e).mesh().cell_vertices;
+             py::array_t<int> out({static_cast<py::ssize_t>(cv.size()), py::ssize_t{4}});
+             if (!cv.empty()) std::memcpy(out.mutable_data(), cv.data(), cv.size() * sizeof(cv[0]));
+             return out;
+           }))
+      .def("cell_volumes", exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).cells().volume); }))
+      .def("cell_fluid_volumes",
+           exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).cells().fluid_volume); }))
+      .def("cell_centers",
+           exclusive([](const SharedEngine& e) { return points_to_array(meshed(e).cells().power_centre); }))
+      .def("conductances", exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).conductances()); }))
+      .def("facet_cells", exclusive([](const SharedEngine& e) { return meshed(e).facets().cell; }));
+}
+
+}  // namespace pfv::python

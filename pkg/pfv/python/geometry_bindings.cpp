@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "pfv/model/cell_velocity.hpp"
 #include "pfv/python/shared_engine.hpp"
 
 namespace pfv::python {
@@ -21,7 +22,12 @@ void bind_geometry(EngineClass& engine) {
       .def("cell_centers",
            exclusive([](const SharedEngine& e) { return points_to_array(meshed(e).cells().power_centre); }))
       .def("conductances", exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).conductances()); }))
-      .def("facet_cells", exclusive([](const SharedEngine& e) { return meshed(e).facets().cell; }));
+      .def("facet_cells", exclusive([](const SharedEngine& e) { return meshed(e).facets().cell; }))
+      .def(
+          "cell_velocities", exclusive([](const SharedEngine& e) {
+            return points_to_array(mean_cell_velocities(meshed(e).cells(), e.facets(), e.conductances(), e.pressure()));
+          }),
+          "Mean fluid velocity of every cell from the throat fluxes of the last step (cell_velocity.hpp).");
 }
 
 }  // namespace pfv::python

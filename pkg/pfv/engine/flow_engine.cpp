@@ -39,6 +39,46 @@ void FlowEngine::release() {
   last_solve_ = SolveStats{};
 }
 
+FlowEngine::RunState FlowEngine::run_state() const {
+  if (!has_mesh()) throw std::logic_error("the engine has no mesh to save: run a step first");
+  RunState s;
+  s.mesh = mesh_->source;
+  if (has_prev_) {
+    s.previous_centres = centres_prev_;
+    s.previous_walls = walls_prev_;
+  }
+  s.pressure = pressure_;
+  s.steps_since_remesh = steps_since_remesh_;
+  s.strain = strain_;
+  return s;
+}
+
+void FlowEngine::resume(const RunState& s, double dt) {
+  release();
+  validate(settings);
+  validate(bc);
+  validate_snapshot(s.mesh.centres, s.mesh.radii, s.mesh.walls);
+  has_prev_ = !s.previous_centres.empty();
+  if (has_prev_) {
+    validate_snapshot(s.previous_centres, s.mesh.radii, s.previous_walls);
+    centres_prev_ = s.previous_centres;
+    walls_prev_ = s.previous_walls;
+  }
+  try {
+    remesh_now(s.mesh.centres, s.mesh.radii, s.mesh.walls, dt);  // dV/dt reference volumes from centres_prev_
+    if (s.pressure.size() != pressure_.size())
+      throw std::invalid_argument("the saved pressures (" + std::to_string(s.pressure.size()) +
+                                  " cells) do not fit the rebuilt mesh (" + std::to_string(pressure_.size()) +
+                                  " cells)");
+  } catch (...) {
+    release();
+    throw;
+  }
+  pressure_ = s.pressure;
+  steps_since_remesh_ = s.steps_since_remesh;
+  strain_ = s.strain;
+}
+
 bool FlowEngine::remesh_due() const {
   return remesh_requested_ || !has_mesh() ||
          (settings.mesh_update_interval > 0 && steps_since_remesh_ >= settings.mesh_update_interval) ||

@@ -42,6 +42,23 @@ class FlowEngine {
   // Free the mesh, the system and every per-cell result (keeping the settings and boundary
   // conditions): for an engine taken out of use. A later step starts afresh with a remesh.
   void release();
+
+  // What a run needs to go on exactly where it stopped (a saved and reloaded simulation): the
+  // positions the current mesh was built from, the positions of the last step, the pressures,
+  // and the remesh schedule. resume() rebuilds the same mesh (the triangulation is a function of
+  // its input) and restores the rest, so that the next step equals the uninterrupted run's.
+  struct RunState {
+    MeshSource mesh;
+    std::vector<Vec3> previous_centres;  // empty: no dV/dt history
+    BoxWalls previous_walls;
+    std::vector<double> pressure;  // per cell of the mesh
+    int steps_since_remesh = 0;
+    double strain = 0;
+  };
+  RunState run_state() const;  // needs a mesh
+  // Throws std::invalid_argument (as a step would) for a state whose positions are invalid, or
+  // whose pressures do not match the rebuilt mesh; the engine is then left without a mesh.
+  void resume(const RunState& state, double dt);
   bool remesh_due() const;
   bool remesh_pending() const { return pending_.has_value(); }
   // Blocks until a background remesh in flight has finished; the next step adopts it.

@@ -48,6 +48,7 @@ PoreMesh build_pore_mesh(const std::vector<Vec3>& centres, const std::vector<dou
   check_distinct_centres(centres);
 
   PoreMesh m(settings);
+  m.source = MeshSource{centres, radii, walls};
   auto t0 = StageClock::now();
   const Mesh& mesh = m.tri.build(centres, radii, walls);
   const auto inside = m.tri.centres_inside_neighbours(centres, radii);

@@ -35,7 +35,15 @@ struct MeshRecipe {
   bool stale_for(const EngineSettings& s) const;
 };
 
+// The positions a mesh was built from: enough to build the same mesh again (a resumed run).
+struct MeshSource {
+  std::vector<Vec3> centres;
+  std::vector<double> radii;
+  BoxWalls walls;
+};
+
 struct PoreMesh {
+  MeshSource source;
   RegularTriangulation tri;
   CellGeometry cells;
   FacetGeometry facets;

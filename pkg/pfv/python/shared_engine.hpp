@@ -113,6 +113,7 @@ inline void check_wall(int w) {
 using EngineClass = py::class_<SharedEngine>;
 
 // The binding groups of pfv.Engine defined in files of their own (python_module.cpp calls them).
-void bind_geometry(EngineClass& engine);  // geometry_bindings.cpp
+void bind_geometry(EngineClass& engine);     // geometry_bindings.cpp
+void bind_persistence(EngineClass& engine);  // persistence_bindings.cpp
 
 }  // namespace pfv::python

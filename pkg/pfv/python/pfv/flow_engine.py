@@ -33,6 +33,7 @@ from yade.wrapper import PyRunner
 from yade.minieigenHP import Vector3
 
 from . import _attributes as attributes
+from . import _persistence
 from ._core import Engine, set_num_threads
 from ._scene_scan import SceneScan
 from ._time_step import TimeStepGuard, TimeStepWarning, viscous_time_step
@@ -48,15 +49,21 @@ _MAX_THREADS = 1024  # ompThreads beyond this is a typo, not a machine
 _SCENE_TAG = "pfv.FlowEngine"  # key in O.tags of the token that tells this scene from a new one
 
 
+_COMMAND = "__import__('pfv.flow_engine').flow_engine._run({})"
+
+
 def _run(key: int) -> None:
     engine = _engines.get(key)
-    # After O.load the running PyRunner is a restored copy, not this engine (which may still be
-    # alive in this process): driving the old object would be silently wrong.
+    # After a load the running PyRunner is a restored copy, not this engine (which may still be
+    # alive in this process): driving the old object would be silently wrong. A scene loaded
+    # by O.load is adopted at the load; one loaded otherwise (yade file.yade.gz) is adopted here.
     if engine is None or not any(e is engine for e in yade.O.engines):
-        raise RuntimeError(
-            "this pfv.FlowEngine must be re-created: after O.save/O.load YADE restores it as a "
-            "plain PyRunner, which cannot drive the flow; create a new pfv.FlowEngine and put it "
-            "back into O.engines")
+        engine = _persistence.adopt_runner(_COMMAND.format(key))
+        if engine is None:
+            raise RuntimeError(
+                "this pfv.FlowEngine must be re-created: YADE restored it as a plain PyRunner and the "
+                "scene carries no saved state for it (saved before PFV could add it?); create a new "
+                "pfv.FlowEngine and put it back into O.engines")
     engine._step()
 
 
@@ -72,6 +79,14 @@ def _release_unused(current: FlowEngine) -> None:
             _holding.discard(key)
         elif engine._in_scene(yade.O) and not any(e is engine for e in engines):
             engine._release()
+
+
+# The core's settings saved with a scene: every one a user may set (YADE's names map onto most).
+# The upper clamp first: restoring must never meet a lower bound above the default upper one.
+_SAVED_CORE_SETTINGS = ("max_k_div_k_mean",) + tuple(sorted(
+    (set(attributes.CORE_NAME.values()) | {"solver", "ordering", "max_iterations", "reuse_ordering",
+                                           "cholmod_openmp_teams"}) - {"max_k_div_k_mean"}))
+_SAVED_GUARD_SETTINGS = ("safety", "strict", "iterations", "iterations_warm")
 
 
 # Python-side state of a FlowEngine (not YADE attributes), set as plain instance attributes.
@@ -129,7 +144,7 @@ class FlowEngine(PyRunner):
         self._threads = None
         self._guard = TimeStepGuard()
         _engines[self._key] = self
-        self.command = f"__import__('pfv.flow_engine').flow_engine._run({self._key})"
+        self.command = _COMMAND.format(self._key)
         self.iterPeriod = 1
         self.initRun = True
         for name, value in kwargs.items():
@@ -543,6 +558,65 @@ class FlowEngine(PyRunner):
     def metisUsed(self) -> bool:
         return self._core.metis_used()
 
+    # -- O.save / O.load (_persistence) -----------------------------------------------------
+    @staticmethod
+    def drives(command: str) -> bool:
+        """Whether a PyRunner command is that of a pfv.FlowEngine (a restored one after a load)."""
+        return command.startswith(_COMMAND.split("{")[0])
+
+    @_exclusive
+    def _saved_state(self) -> dict[str, Any]:
+        """Everything a new engine needs to go on where this one is: settings, boundary conditions,
+        the Python-side settings and, once it has run, the core's run state."""
+        core = self._core
+        running = core.has_mesh() and self._stepped is not None
+        return {
+            "core": {name: getattr(core, name) for name in _SAVED_CORE_SETTINGS},
+            "bnd_is_pressure": list(core.bnd_is_pressure),
+            "bnd_value": list(core.bnd_value),
+            "imposed_pressures": core.imposed_pressures(),
+            "imposed_fluxes": core.imposed_fluxes(),
+            "boundary_use_max_min": list(self._boundary_use_max_min),
+            "wall_ids": list(self._wall_ids),
+            "threads": self._threads,
+            "use_sphere_pack": self._use_sphere_pack,
+            "guard": {name: getattr(self._guard, name) for name in _SAVED_GUARD_SETTINGS},
+            "runner": {name: getattr(self, name) for name in ("iterPeriod", "dead", "initRun")},
+            "last_step": list(self._last_step) if running and self._last_step else None,
+            "run": core.run_state() if running else None,
+        }
+
+    @classmethod
+    def _from_saved(cls, state: dict[str, Any], runner: PyRunner) -> FlowEngine:
+        """A new engine from _saved_state() in the loaded scene, in place of the restored `runner`."""
+        engine = cls()
+        core = engine._core
+        for name in _SAVED_CORE_SETTINGS:
+            setattr(core, name, state["core"][name])
+        core.bnd_is_pressure = state["bnd_is_pressure"]
+        core.bnd_value = state["bnd_value"]
+        for pos, p in state["imposed_pressures"]:
+            core.impose_pressure(tuple(pos), p)
+        for pos, q in state["imposed_fluxes"]:
+            core.impose_flux(tuple(pos), q)
+        engine._boundary_use_max_min = list(state["boundary_use_max_min"])
+        engine._wall_ids = list(state["wall_ids"])
+        engine._threads = state["threads"]
+        engine._use_sphere_pack = state["use_sphere_pack"]
+        for name, value in state["guard"].items():
+            setattr(engine._guard, name, value)
+        for name, value in state["runner"].items():
+            setattr(engine, name, value)
+        engine.label = runner.label
+        if state["run"] is not None:
+            scene = yade.O
+            engine._notice_new_scene(scene)
+            core.resume(state["run"], scene.dt)
+            engine._stepped = engine._rescan()
+            engine._last_step = tuple(state["last_step"])
+            _holding.add(engine._key)
+        return engine
+
     # -- PFV extras -------------------------------------------------------------------------
     @property
     def core(self) -> Engine:
@@ -553,3 +627,5 @@ class FlowEngine(PyRunner):
 # Names set as ordinary attributes: PyRunner's (command, iterPeriod, label, ...) and FlowEngine's properties.
 _OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
     name for name, v in vars(FlowEngine).items() if isinstance(v, property)}
+
+_persistence.install()  # O.save / O.load carry the engines' state

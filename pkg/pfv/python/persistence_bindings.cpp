@@ -1,0 +1,64 @@
+// The run state of an engine as numpy arrays, to be saved with a YADE scene and resumed after
+// O.load (pfv/_persistence.py).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "pfv/python/shared_engine.hpp"
+
+namespace pfv::python {
+namespace {
+
+py::dict to_dict(const FlowEngine::RunState& s) {
+  py::dict d;
+  d["mesh_centres"] = points_to_array(s.mesh.centres);
+  d["mesh_radii"] = vector_to_array(s.mesh.radii);
+  d["mesh_walls"] = s.mesh.walls.coord;
+  d["previous_centres"] = points_to_array(s.previous_centres);
+  d["previous_walls"] = s.previous_walls.coord;
+  d["pressure"] = vector_to_array(s.pressure);
+  d["steps_since_remesh"] = s.steps_since_remesh;
+  d["strain"] = s.strain;
+  return d;
+}
+
+FlowEngine::RunState from_dict(const py::dict& d) {
+  FlowEngine::RunState s;
+  s.mesh.centres = to_points(d["mesh_centres"].cast<Array>(), "mesh_centres");
+  s.mesh.radii = to_vector(d["mesh_radii"].cast<Array>(), "mesh_radii");
+  s.mesh.walls = to_walls(d["mesh_walls"].cast<std::array<double, 6>>());
+  const Array previous = d["previous_centres"].cast<Array>();
+  if (previous.size() > 0) s.previous_centres = to_points(previous, "previous_centres");
+  s.previous_walls = to_walls(d["previous_walls"].cast<std::array<double, 6>>());
+  s.pressure = to_vector(d["pressure"].cast<Array>(), "pressure");
+  s.steps_since_remesh = d["steps_since_remesh"].cast<int>();
+  s.strain = d["strain"].cast<double>();
+  return s;
+}
+
+py::list conditions(const std::vector<PointCondition>& list) {
+  py::list out;
+  for (const PointCondition& c : list)
+    out.append(py::make_tuple(py::make_tuple(c.position.x(), c.position.y(), c.position.z()), c.value));
+  return out;
+}
+
+}  // namespace
+
+void bind_persistence(EngineClass& engine) {
+  engine
+      .def("run_state", exclusive([](const SharedEngine& e) { return to_dict(e.run_state()); }),
+           "The state a run needs to go on after a save (FlowEngine::RunState) as a dict of arrays.")
+      .def("resume", exclusive([](SharedEngine& e, const py::dict& state, double dt) {
+             const FlowEngine::RunState s = from_dict(state);
+             py::gil_scoped_release release;
+             e.resume(s, dt);
+           }),
+           py::arg("state"), py::arg("dt"), "Rebuild the mesh and the history of run_state() (FlowEngine::resume).")
+      .def("imposed_pressures", exclusive([](const SharedEngine& e) { return conditions(e.bc.imposed_pressure); }),
+           "[((x, y, z), p), ...] of impose_pressure, in index order.")
+      .def("imposed_fluxes", exclusive([](const SharedEngine& e) { return conditions(e.bc.imposed_flux); }),
+           "[((x, y, z), q), ...] of impose_flux (q positive into the pore), in index order.");
+}
+
+}  // namespace pfv::python

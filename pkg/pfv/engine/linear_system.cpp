@@ -34,6 +34,21 @@ std::vector<int> locate_points(const PoreMesh& m, const std::vector<PointConditi
   return cells;
 }
 
+// Whether a carried-over ordering is of the kind asked for: METIS (or its nested dissection)
+// or AMD when one is named (forceMetis must give a METIS ordering), anything under kAuto.
+bool ordering_fits(const CellOrdering& previous, Ordering wanted) {
+  switch (wanted) {
+    case Ordering::kMetis:
+    case Ordering::kNestedDissection:
+      return previous.from_metis();
+    case Ordering::kAmd:
+      return !previous.from_metis();
+    case Ordering::kAuto:
+      break;
+  }
+  return true;
+}
+
 std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
   switch (kind) {
     case SolverKind::kGaussSeidel:
@@ -115,7 +130,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       options.precision = settings.mixed_precision ? FactorPrecision::kScaled32 : FactorPrecision::kDouble;
       options.min_scaled_entries = settings.mixed_precision_min_entries;
       options.openmp_teams = settings.cholmod_openmp_teams;
-      if (previous && settings.reuse_ordering) {
+      if (previous && settings.reuse_ordering && ordering_fits(*previous, options.ordering)) {
         options.given.perm = previous->carry_over(m.mesh(), s);
         options.given.max_fill = settings.max_fill_growth * previous->fresh_fill();
         options.given.from_metis = previous->from_metis();

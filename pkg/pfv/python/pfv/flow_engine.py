@@ -36,6 +36,7 @@ from . import _attributes as attributes
 from . import _persistence
 from ._core import Engine, set_num_threads
 from ._scene_scan import SceneScan
+from ._timing import StageTimings, StepClock
 from ._time_step import TimeStepGuard, TimeStepWarning, viscous_time_step
 
 __all__ = ["FlowEngine", "TimeStepWarning"]
@@ -99,6 +100,7 @@ _INTERNAL = frozenset({
     "_scene_tag",             # the value this engine left in O.tags: a new scene lacks it
     "_last_step",             # (O.iter, O.time) of the last successful step, None: no history
     "_guard",                 # the TimeStepGuard
+    "_timings",               # the StageTimings shown by timing.stats()
     "_boundary_use_max_min",  # boundaryUseMaxMin
     "_wall_ids",              # wallIds
     "_warned",                # the one-time warnings given
@@ -133,6 +135,7 @@ class FlowEngine(PyRunner):
         self._core = Engine()
         self._key = id(self)
         self._lock = threading.RLock()
+        self._timings = StageTimings()
         self._stepped = None
         self._scene_tag = None
         self._last_step = None
@@ -329,6 +332,7 @@ class FlowEngine(PyRunner):
     def _step(self) -> None:
         scene = yade.O
         core = self._core
+        clock = StepClock(self._timings) if scene.timingEnabled else None
         self._notice_new_scene(scene)
         scan = self._scan
         bodies_changed = scan is None or scan.outdated or len(scene.bodies) != scan.n_bodies
@@ -344,14 +348,20 @@ class FlowEngine(PyRunner):
         scan = self._scan
         pos, walls = read
         set_num_threads(self._threads or scene.numThreads)
+        if clock:
+            clock.lap("scan and positions")
         dt = self._time_since_last_step(scene)
         # Before the step, only limits known for the mesh the step will use (a mesh about to be
         # rebuilt, or conductances about to change, have no limit yet: checked after the step).
         self._check_time_step(scene.dt, scan, collective=self._guard.known_limit(core))
         remeshing = core.remesh_due()
-        inversions = core.inversion_remeshes
+        inversions, meshes = core.inversion_remeshes, core.remesh_count
+        if clock:
+            clock.lap("time-step guard")
         with self._bodies_named(scan):
             core.step(pos, scan.radii, walls, dt)
+        if clock:
+            clock.core_step(core, core.remesh_count != meshes)
         self._stepped = scan
         self._last_step = (scene.iter, scene.time)
         _holding.add(self._key)
@@ -378,8 +388,17 @@ class FlowEngine(PyRunner):
                 warnings.warn(f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
                               f"regular triangulation and get no fluid force (ids {yade_ids}...)",
                               stacklevel=2)
+        if clock:
+            clock.lap("time-step guard and warnings")
         # The engine's force array is read in C++, without a numpy copy.
         scan.force_bridge.apply(scene.forces.addF, core)
+        if clock:
+            clock.lap("forces to YADE")
+
+    @property
+    def timingDeltas(self) -> StageTimings:
+        """The engine's stages for YADE's timing.stats() while O.timingEnabled (_timing.py)."""
+        return self._timings
 
     @contextlib.contextmanager
     def _bodies_named(self, scan: SceneScan):

@@ -24,7 +24,7 @@ out = io.StringIO()
 with contextlib.redirect_stdout(out):
     timing.stats()
 report = out.getvalue()
-rb.check("timing.stats() lists the stages under the engine", all(
+rb.check("timing.stats() lists the stages under the engine", all(  # noqa: E501
     label in report for label in ("solve", "dV/dt", "remesh: triangulation", "system: factorization", "forces to YADE")))
 rb.check("every step counts once in the per-step stages", data["solve"][1] == 20 and data["forces to YADE"][1] == 20)
 rb.check("the remesh stages count the remeshes", data["remesh: triangulation"][1] == remeshes == 4,

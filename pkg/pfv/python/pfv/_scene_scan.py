@@ -28,6 +28,19 @@ _coordinates = yade._utils.coordsAndDisplacements
 _WALL_SHAPES = (Box, Wall, Facet)  # the shapes a body named in wallIds may have
 
 
+def _equivalent_radius(scene, clump) -> float:
+    """The radius of the sphere of the clump's volume (the sum of its members' volumes), placed at its
+    centre of mass: how a clump enters the triangulation with convertClumps, as in YADE."""
+    cubes = 0.0
+    for member in clump.shape.members.keys():
+        shape = scene.bodies[member].shape
+        if not isinstance(shape, Sphere):
+            raise NotImplementedError(f"pfv.FlowEngine: clump #{clump.id} has a member that is not a sphere "
+                                      f"(#{member}, {type(shape).__name__})")
+        cubes += shape.radius ** 3
+    return cubes ** (1.0 / 3.0)
+
+
 class SceneScan:
     """Sphere ids, radii, masses and wall bodies of the scene, and how to read their positions.
 
@@ -37,7 +50,8 @@ class SceneScan:
     """
 
     def __init__(self, wall_ids: Sequence[int], use_max_min: Sequence[bool], *, use_sphere_pack: bool = True,
-                 warned: set[str] | None = None, previous: SceneScan | None = None) -> None:
+                 convert_clumps: bool = True, warned: set[str] | None = None,
+                 previous: SceneScan | None = None) -> None:
         scene = yade.O
         if scene.periodic:
             raise NotImplementedError("pfv.FlowEngine does not support periodic scenes yet")
@@ -59,31 +73,35 @@ class SceneScan:
             pack_size += is_sphere
             if bid in wall_set:
                 continue
-            if is_clump or b.isClumpMember:
+            if is_clump:
+                if not convert_clumps:
+                    continue  # its members are the spheres
+                radius = _equivalent_radius(scene, b)
                 clumps += 1
+            elif b.isClumpMember and convert_clumps:
+                continue  # the clump stands for it
             elif is_sphere:
                 radius = shape.radius
-                pack_index.append(pack_size - 1)
-                ids.append(bid)
-                radii.append(radius)
-                rows.append(row)
-                state = b.state
-                mass = state.mass
-                if not math.isfinite(mass) or mass < 0:
-                    raise ValueError(f"pfv.FlowEngine: sphere #{bid} has mass {mass}: a coupled sphere needs a "
-                                     "finite mass >= 0")
-                moving = b.dynamic and mass > 0 and state.blockedDOFs != "xyzXYZ"
-                masses.append(mass if moving else 0.0)
-                if moving:
-                    mass_per_diameter = min(mass_per_diameter, mass / (2 * radius))
             else:
                 others += 1
+                continue
+            pack_index.append(pack_size - 1 if is_sphere else -1)
+            ids.append(bid)
+            radii.append(radius)
+            rows.append(row)
+            state = b.state
+            mass = state.mass
+            if not math.isfinite(mass) or mass < 0:
+                raise ValueError(f"pfv.FlowEngine: sphere #{bid} has mass {mass}: a coupled sphere needs a "
+                                 "finite mass >= 0")
+            moving = b.dynamic and mass > 0 and state.blockedDOFs != "xyzXYZ"
+            masses.append(mass if moving else 0.0)
+            if moving:
+                mass_per_diameter = min(mass_per_diameter, mass / (2 * radius))
         if not ids:
             raise ValueError(f"pfv.FlowEngine: the scene has no sphere to couple with the fluid "
                              f"({len(row_of)} bodies, walls wallIds = {self.wall_ids})")
-        if clumps:
-            raise NotImplementedError(
-                f"pfv.FlowEngine does not support clumps yet ({clumps} clump bodies or members in the scene)")
+        self.clumps = clumps  # clumps entered as their equivalent spheres
         if warned is None:
             warned = set()
         if others and "others" not in warned:
@@ -129,7 +147,7 @@ class SceneScan:
         self.pack: SpherePack | None = None  # a SpherePack whose array this scan reads, or None
         self.pack_index: np.ndarray | None = None  # the spheres' places in the pack
         self.pack_size = 0  # sphere bodies in the pack
-        if use_sphere_pack:
+        if use_sphere_pack and not clumps:  # a SpherePack lists no clump bodies
             self._choose_position_reader(np.array(pack_index, dtype=np.int64), pack_size, use_max_min)
 
     def _make_force_bridge(self, ids: list[int], wall_rows: list[int],

@@ -106,6 +106,7 @@ _INTERNAL = frozenset({
     "_warned",                # the one-time warnings given
     "_threads",               # ompThreads, None: follow YADE's -j
     "_use_sphere_pack",       # False: always read the coordinate lists
+    "_convert_clumps",        # convertClumps
 })
 
 
@@ -144,6 +145,7 @@ class FlowEngine(PyRunner):
         self._warned = set()
         self._scan = None
         self._use_sphere_pack = True
+        self._convert_clumps = True
         self._threads = None
         self._guard = TimeStepGuard()
         _engines[self._key] = self
@@ -221,6 +223,22 @@ class FlowEngine(PyRunner):
             self._core.reset_history()
 
     @property
+    def convertClumps(self) -> bool:
+        """True (YADE's default): a clump enters the triangulation as the sphere of its volume at its
+        centre of mass, and its fluid force goes to the clump; False: its spherical members are
+        triangulated as spheres of their own (YADE's Newton integrator sums their forces)."""
+        return self._convert_clumps
+
+    @convertClumps.setter
+    def convertClumps(self, value: bool) -> None:
+        value = attributes.as_setting("convertClumps", value, True)
+        if value != self._convert_clumps:
+            with self._lock:
+                self._convert_clumps = value
+                if self._scan is not None:
+                    self._scan.outdated = True
+
+    @property
     def useSolver(self) -> int:
         """YADE's solver number: 0 Gauss-Seidel, 1 conjugate gradients (PFV), 3 CHOLMOD."""
         return attributes.use_solver_of(self._core.solver)
@@ -265,6 +283,7 @@ class FlowEngine(PyRunner):
     def _rescan(self) -> SceneScan:
         """Scan the bodies again (sphere ids, radii, masses, walls); done at each remesh (bodies may change)."""
         self._scan = SceneScan(self._wall_ids, self._boundary_use_max_min, use_sphere_pack=self._use_sphere_pack,
+                               convert_clumps=self._convert_clumps,
                                warned=self._warned, previous=self._scan)
         return self._scan
 
@@ -599,6 +618,7 @@ class FlowEngine(PyRunner):
             "wall_ids": list(self._wall_ids),
             "threads": self._threads,
             "use_sphere_pack": self._use_sphere_pack,
+            "convert_clumps": self._convert_clumps,
             "guard": {name: getattr(self._guard, name) for name in _SAVED_GUARD_SETTINGS},
             "runner": {name: getattr(self, name) for name in ("iterPeriod", "dead", "initRun")},
             "last_step": list(self._last_step) if running and self._last_step else None,
@@ -622,6 +642,7 @@ class FlowEngine(PyRunner):
         engine._wall_ids = list(state["wall_ids"])
         engine._threads = state["threads"]
         engine._use_sphere_pack = state["use_sphere_pack"]
+        engine._convert_clumps = state.get("convert_clumps", True)
         for name, value in state["guard"].items():
             setattr(engine._guard, name, value)
         for name, value in state["runner"].items():

@@ -73,6 +73,8 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
       {"cholmod_openmp_teams", [](FlowEngine& e) { e.settings.cholmod_openmp_teams = true; }},
       {"def_tolerance", [](FlowEngine& e) { e.settings.def_tolerance = 0.5; }},
       {"p_zero", [](FlowEngine& e) { e.settings.p_zero = 1.0; }},
+      {"fluid_density", [](FlowEngine& e) { e.settings.fluid_density = 1000.0; }},
+      {"gravity", [](FlowEngine& e) { e.settings.gravity = Vec3(0.0, -9.81, 0.0); }},
       {"background_remesh", [](FlowEngine& e) { e.settings.background_remesh = true; }},
   };
   return table;

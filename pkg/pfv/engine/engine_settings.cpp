@@ -48,6 +48,9 @@ void validate(const EngineSettings& s) {
   require(s.max_refinement_passes > 0, named("max_refinement_passes", s.max_refinement_passes, "positive"));
   require(std::isfinite(s.def_tolerance), named("defTolerance", s.def_tolerance, "finite"));
   require(std::isfinite(s.p_zero), named("pZero", s.p_zero, "finite"));
+  require(s.fluid_density >= 0 && std::isfinite(s.fluid_density),
+          named("fluid_density", s.fluid_density, ">= 0 and finite"));
+  require(s.gravity.allFinite(), "gravity must be finite");
   require(s.fluid_bulk_modulus >= 0 && std::isfinite(s.fluid_bulk_modulus),
           named("fluidBulkModulus", s.fluid_bulk_modulus, ">= 0 and finite"));
 }

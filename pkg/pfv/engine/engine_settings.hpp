@@ -53,6 +53,11 @@ struct EngineSettings {
   // Viscous shear between neighbouring spheres (YADE's viscousShear; viscous_shear.hpp). Off:
   // no pair geometry is built or stored and the step does no extra work.
   bool viscous_shear = false;
+  // Buoyancy: the engine solves for the excess (piezometric) pressure, so the hydrostatic part of
+  // the fluid's action is the force -fluid_density V g on every sphere, added to its fluid force
+  // when fluid_density > 0 (thesis 2.17: the buoyant weight). 0: no buoyancy, no cost.
+  double fluid_density = 0;
+  Vec3 gravity = Vec3::Zero();
 
   SolveControl solve_control() const {
     return {tolerance, relax, max_iterations, refinement_tolerance, max_refinement_passes};

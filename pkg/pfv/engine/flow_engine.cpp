@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -119,7 +120,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     strain = assemble(centres, walls, dt);
   }
   solve();
-  compute_forces(centres, dt);
+  compute_forces(centres, radii, dt);
   commit(centres, walls, strain);
   step_times_.total = seconds_since(start);
 }
@@ -317,9 +318,13 @@ void FlowEngine::solve() {
   step_times_.solve = seconds_since(t0);
 }
 
-void FlowEngine::compute_forces(const std::vector<Vec3>& centres, double dt) {
+void FlowEngine::compute_forces(const std::vector<Vec3>& centres, const std::vector<double>& radii, double dt) {
   auto t0 = StageClock::now();
   mesh_->cache.apply(next_pressure_, next_force_);
+  if (settings.fluid_density > 0) {
+    const Vec3 weight = settings.fluid_density * (4.0 / 3.0) * std::numbers::pi * settings.gravity;
+    for (std::size_t k = 0; k < radii.size(); ++k) next_force_[k] -= radii[k] * radii[k] * radii[k] * weight;
+  }
   step_times_.forces = seconds_since(t0);
 
   if (!settings.viscous_shear && mesh_->shear) {  // switched off (or adopted from before)

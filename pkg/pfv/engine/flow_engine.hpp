@@ -141,7 +141,7 @@ class FlowEngine {
   void rebuild_stale_system(double dt);
   double assemble(const std::vector<Vec3>& centres, const BoxWalls& walls, double dt);  // returns the pore strain
   void solve();
-  void compute_forces(const std::vector<Vec3>& centres, double dt);
+  void compute_forces(const std::vector<Vec3>& centres, const std::vector<double>& radii, double dt);
   void commit(const std::vector<Vec3>& centres, const BoxWalls& walls, double strain);
 
   void adopt_finished_remesh();

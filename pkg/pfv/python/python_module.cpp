@@ -236,6 +236,17 @@ PYBIND11_MODULE(_core, m) {
       .def_property("def_tolerance", get_setting(&EngineSettings::def_tolerance),
                     set_setting(&EngineSettings::def_tolerance))
       .def_property("p_zero", get_setting(&EngineSettings::p_zero), set_setting(&EngineSettings::p_zero))
+      .def_property("fluid_density", get_setting(&EngineSettings::fluid_density),
+                    set_setting(&EngineSettings::fluid_density),
+                    "Buoyancy: > 0 adds -fluid_density V g to every sphere's fluid force (0: off).")
+      .def_property(
+          "gravity", exclusive([](const SharedEngine& e) {
+            return std::array<double, 3>{e.settings.gravity.x(), e.settings.gravity.y(), e.settings.gravity.z()};
+          }),
+          exclusive([](SharedEngine& e, const std::array<double, 3>& g) {
+            update(e, [&](EngineSettings& s) { s.gravity = Vec3(g[0], g[1], g[2]); });
+          }),
+          "The gravity of the buoyancy term (pfv.FlowEngine copies the NewtonIntegrator's).")
       // Boundary conditions.
       .def_property("bnd_is_pressure", exclusive([](const SharedEngine& e) { return e.bc.is_pressure; }),
                     exclusive([](SharedEngine& e, const std::array<bool, 6>& v) { e.bc.is_pressure = v; }))

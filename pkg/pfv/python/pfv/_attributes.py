@@ -41,6 +41,7 @@ CORE_NAME: dict[str, str] = {
     "mixed_precision": "mixed_precision",
     "mixed_precision_min_entries": "mixed_precision_min_entries",
     "refinement_tolerance": "refinement_tolerance",
+    "fluid_density": "fluid_density",
     "yade_wall_throat_factor": "yade_wall_throat_factor",
 }
 

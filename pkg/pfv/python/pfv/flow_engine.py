@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 import yade
-from yade.wrapper import PyRunner
+from yade.wrapper import NewtonIntegrator, PyRunner
 from yade.minieigenHP import Vector3
 
 from . import _attributes as attributes
@@ -66,6 +66,14 @@ def _run(key: int) -> None:
                 "scene carries no saved state for it (saved before PFV could add it?); create a new "
                 "pfv.FlowEngine and put it back into O.engines")
     engine._step()
+
+
+def _gravity(scene: Any) -> tuple[float, float, float]:
+    """The gravity of the scene's NewtonIntegrator (zero without one)."""
+    for engine in scene.engines:
+        if isinstance(engine, NewtonIntegrator):
+            return tuple(engine.gravity)
+    return (0.0, 0.0, 0.0)
 
 
 def _release_unused(current: FlowEngine) -> None:
@@ -370,6 +378,8 @@ class FlowEngine(PyRunner):
         if clock:
             clock.lap("scan and positions")
         dt = self._time_since_last_step(scene)
+        if core.fluid_density > 0:  # buoyancy under the NewtonIntegrator's gravity
+            core.gravity = _gravity(scene)
         # Before the step, only limits known for the mesh the step will use (a mesh about to be
         # rebuilt, or conductances about to change, have no limit yet: checked after the step).
         self._check_time_step(scene.dt, scan, collective=self._guard.known_limit(core))
@@ -595,6 +605,22 @@ class FlowEngine(PyRunner):
     @_exclusive
     def metisUsed(self) -> bool:
         return self._core.metis_used()
+
+    @_exclusive
+    def absolute_pressure(self, pos: Sequence[float]) -> float:
+        """The pore pressure at pos with its hydrostatic part: getPorePressure(pos) + fluid_density g.(pos - top),
+        `top` the centre of the wall that faces up (against gravity's largest component). Equals the
+        excess pressure without buoyancy (fluid_density = 0)."""
+        p = self._core.cell_pressure(self._cell_at(pos))
+        rho = self._core.fluid_density
+        if rho == 0:
+            return p
+        g = np.array(self._core.gravity)
+        walls = self._core.walls()
+        top = np.array([(walls[0] + walls[1]) / 2, (walls[2] + walls[3]) / 2, (walls[4] + walls[5]) / 2])
+        axis = int(np.abs(g).argmax())
+        top[axis] = walls[2 * axis + 1] if g[axis] < 0 else walls[2 * axis]
+        return p + rho * float(g @ (np.asarray(attributes.as_point("position", pos)) - top))
 
     # -- O.save / O.load (_persistence) -----------------------------------------------------
     @staticmethod

@@ -385,4 +385,5 @@ PYBIND11_MODULE(_core, m) {
       .def("remesh_times", exclusive([](const SharedEngine& e) { return times_dict(e.remesh_times()); }))
       .def("step_times", exclusive([](const SharedEngine& e) { return times_dict(e.step_times()); }));
   bind_geometry(engine);
+  bind_output(engine);
 }

@@ -104,6 +104,8 @@ class FlowEngine {
   const std::vector<double>& conductances() const { return mesh_->k; }
   const PressureSystem& system() const { return linear_.system; }
   const BoxWalls& walls() const { return walls_prev_; }
+  // The sphere centres of the last step (empty before the first): the positions of walls() and pressure().
+  const std::vector<Vec3>& positions() const { return centres_prev_; }
   double boundary_flux(int wall) const;
   double imposed_flux_total() const;
   double volume_rate_total() const;  // sum of dV/dt over all cells

@@ -397,4 +397,5 @@ PYBIND11_MODULE(_core, m) {
       .def("step_times", exclusive([](const SharedEngine& e) { return times_dict(e.step_times()); }));
   bind_geometry(engine);
   bind_persistence(engine);
+  bind_output(engine);
 }

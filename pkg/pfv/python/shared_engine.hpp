@@ -114,6 +114,7 @@ using EngineClass = py::class_<SharedEngine>;
 
 // The binding groups of pfv.Engine defined in files of their own (python_module.cpp calls them).
 void bind_geometry(EngineClass& engine);     // geometry_bindings.cpp
+void bind_output(EngineClass& engine);       // output_bindings.cpp
 void bind_persistence(EngineClass& engine);  // persistence_bindings.cpp
 
 }  // namespace pfv::python

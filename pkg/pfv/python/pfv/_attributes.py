@@ -126,6 +126,13 @@ def as_bool6(name: str, value: Iterable[Any]) -> list[bool]:
     return [bool(v) for v in _six(name, value, (numbers.Integral, np.bool_), "flags", "a bool")]
 
 
+def as_flag(name: str, value: Any) -> bool:
+    """A flag: a bool or an integer (YADE's converters take both), not a string or None."""
+    if not isinstance(value, (numbers.Integral, np.bool_)):
+        raise TypeError(f"{name} must be a bool, got {value!r}")
+    return bool(value)
+
+
 def as_float6(name: str, value: Iterable[Any]) -> list[float]:
     """Six finite numbers, one per wall (xmin, xmax, ymin, ymax, zmin, zmax)."""
     items = [float(v) for v in _six(name, value, (numbers.Real,), "numbers", "a number")]
@@ -158,9 +165,7 @@ def as_setting(name: str, value: Any, current: Any) -> Any:
     `current` gives the type: a flag (bool or integer), an integer, or a finite number. The core
     checks the ranges; this names the attribute when the type is wrong."""
     if isinstance(current, bool):
-        if not isinstance(value, (numbers.Integral, np.bool_)):
-            raise TypeError(f"{name} must be a bool, got {value!r}")
-        return bool(value)
+        return as_flag(name, value)
     if isinstance(current, int):
         if not isinstance(value, numbers.Integral) or isinstance(value, (bool, np.bool_)):
             raise TypeError(f"{name} must be an integer, got {value!r}")

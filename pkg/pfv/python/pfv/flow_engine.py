@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import numbers
+import os
 import re
 import threading
 import uuid
@@ -682,6 +683,29 @@ class FlowEngine(PyRunner):
             engine._last_step = tuple(state["last_step"])
             _holding.add(engine._key)
         return engine
+
+    # -- output ------------------------------------------------------------------------------
+    def saveVtk(self, folder: str | os.PathLike = "./VTK", withBoundaries: bool = False,
+                compress: bool = False) -> None:
+        """Write the pore network (pressure, mean fluid velocity, imposed-pressure flag, volumes) and the spheres
+        (radii, ids, fluid forces) of the last step into `folder` as VTK XML files for ParaView: out_<N>.vtu,
+        spheres_<N>.vtu and the collection out.pvd of every snapshot this process wrote there, at O.time.
+        withBoundaries=False leaves out the cells with a wall vertex (YADE's default); compress=True compresses
+        the data with zlib. See doc/yade.md, "VTK output"."""
+        if not isinstance(folder, (str, os.PathLike)):
+            raise TypeError(f"saveVtk folder must be a path, got {folder!r}")
+        with_boundaries = attributes.as_flag("saveVtk withBoundaries", withBoundaries)
+        compress = attributes.as_flag("saveVtk compress", compress)
+        try:
+            from . import _vtk_output
+        except ImportError as error:
+            raise ImportError(f"pfv.FlowEngine.saveVtk needs VTK's Python package (Debian: apt-get install "
+                              f"python3-vtk9): {error}") from None
+        with self._lock:
+            self._require_mesh()
+            scan = self._stepped
+            state = _vtk_output.read_state(self._core, scan.ids, scan.radii, scan.wall_ids, yade.O.time)
+        _vtk_output.save(state, os.fspath(folder), with_boundaries, compress)
 
     # -- PFV extras -------------------------------------------------------------------------
     @property

@@ -1,0 +1,40 @@
+// What the VTK output (pfv/_vtk_output.py) reads of the current mesh besides the geometry
+// bindings: the positions the last step ran at, the cell volumes at those positions and the
+// pressure source of every cell (numpy copies).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <vector>
+
+#include "pfv/python/shared_engine.hpp"
+#include "triangulation/pore_geometry.hpp"
+
+namespace pfv::python {
+
+void bind_output(EngineClass& engine) {
+  engine
+      .def("positions", exclusive([](const SharedEngine& e) { return points_to_array(meshed(e).positions()); }),
+           "Sphere centres of the last step (input order): the positions walls(), pressure() and forces() belong to.")
+      .def("current_cell_volumes", exclusive([](const SharedEngine& e) {
+             const CellGeometry& cells = meshed(e).cells();
+             const std::vector<Vec3>& centres = e.positions();
+             if (centres.size() != static_cast<std::size_t>(e.mesh().n_spheres))
+               throw py::value_error("the last step's positions do not belong to the current mesh");
+             std::vector<double> volume(cells.shape.size());
+             for (std::size_t c = 0; c < volume.size(); ++c)
+               volume[c] = cell_volume(cells.shape[c], centres, e.walls());
+             return vector_to_array(volume);
+           }),
+           "Total volume of every cell (tetrahedron or wall prism) at positions() and walls(); cell_volumes() is\n"
+           "the volume at the last remesh.")
+      .def("cell_sources", exclusive([](const SharedEngine& e) {
+             const std::vector<int>& source = meshed(e).system().source;
+             if (source.size() != static_cast<std::size_t>(e.mesh().n_cells()))
+               throw py::value_error("the linear system does not belong to the current mesh (run a step first)");
+             return vector_to_array(source);
+           }),
+           "Pressure source of every cell: wall w (0..5) or 6 + k (imposed pressure k) for a cell whose pressure\n"
+           "is imposed (a Dirichlet cell of the system), -1 for a cell whose pressure is solved for.");
+}
+
+}  // namespace pfv::python

@@ -64,6 +64,8 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
        [](FlowEngine& e) {
          e.bc.imposed_flux.push_back({Vec3(0.5, 0.5, 0.5), -1e-3});
        }},
+      {"set_cell_imposed", [](FlowEngine& e) { e.set_cell_imposed(0, true); }},
+      {"block_cell", [](FlowEngine& e) { e.block_cell(0, false); }},
       {"bnd_value", [](FlowEngine& e) { e.bc.value = {1.0, 0.5, 0, 0, 0, 0}; }},
       {"tolerance", [](FlowEngine& e) { e.settings.tolerance = 1e-8; }},
       {"relax", [](FlowEngine& e) { e.settings.relax = 1.5; }},
@@ -73,6 +75,8 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
       {"cholmod_openmp_teams", [](FlowEngine& e) { e.settings.cholmod_openmp_teams = true; }},
       {"def_tolerance", [](FlowEngine& e) { e.settings.def_tolerance = 0.5; }},
       {"p_zero", [](FlowEngine& e) { e.settings.p_zero = 1.0; }},
+      {"minimum_porosity", [](FlowEngine& e) { e.settings.minimum_porosity = 0.1; }},
+      {"set_cell_pressure", [](FlowEngine& e) { e.set_cell_pressure(0, 0.5); }},
       {"background_remesh", [](FlowEngine& e) { e.settings.background_remesh = true; }},
   };
   return table;

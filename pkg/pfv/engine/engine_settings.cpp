@@ -50,6 +50,7 @@ void validate(const EngineSettings& s) {
   require(std::isfinite(s.p_zero), named("pZero", s.p_zero, "finite"));
   require(s.fluid_bulk_modulus >= 0 && std::isfinite(s.fluid_bulk_modulus),
           named("fluidBulkModulus", s.fluid_bulk_modulus, ">= 0 and finite"));
+  require(s.minimum_porosity >= 0 && s.minimum_porosity < 1, named("minimumPorosity", s.minimum_porosity, "in [0, 1)"));
 }
 
 }  // namespace pfv

@@ -47,6 +47,9 @@ struct EngineSettings {
   // cell stores fluid: (V_f / K) dp/dt enters continuity (implicit Euler), which adds
   // V_f / (K dt) to the diagonal of G; the system is then rebuilt when dt changes.
   double fluid_bulk_modulus = 0;
+  // The pore volume a compressible cell stores is at least minimum_porosity times its total
+  // volume (YADE's minimumPorosity; cell_queries.hpp), in [0, 1).
+  double minimum_porosity = 0;
   // Remesh on a second thread from a snapshot while steps go on with the old mesh (YADE's
   // `multithread`): the new mesh arrives a few steps late.
   bool background_remesh = false;

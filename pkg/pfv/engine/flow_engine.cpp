@@ -33,6 +33,8 @@ void FlowEngine::release() {
     std::vector<double>().swap(*v);
   for (auto* v : {&force_, &next_force_, &shear_force_, &next_shear_, &centres_prev_}) std::vector<Vec3>().swap(*v);
   has_prev_ = keep_trend_ = false;
+  cells_.clear();
+  std::vector<double>().swap(measured_void_volume_);
   strain_ = 0;
   steps_since_remesh_ = 0;
   remesh_requested_ = true;
@@ -184,6 +186,8 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear) {
   linear_ = std::move(linear);
   pressure_ = std::move(pressure);
   pressure_before_.clear();  // other cells
+  cells_.clear();            // their indices named the old cells
+  std::vector<double>().swap(measured_void_volume_);
   const int nc = mesh_->mesh().n_cells();
   volume_.assign(mesh_->cells.volume.begin(), mesh_->cells.volume.end());
   volume_rate_.assign(nc, 0.0);
@@ -202,7 +206,8 @@ void FlowEngine::rebuild_stale_system(double dt) {
   if (mesh_->viscosity() != settings.conductance.viscosity) mesh_->set_viscosity(settings.conductance.viscosity);
   if (linear_.ready() && !system_rebuild_requested_ && !linear_.recipe.stale_for(settings, bc, dt)) return;
   const auto ordering = linear_.ordering;
-  linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver());
+  linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver(),
+                                {&cells_, &measured_void_volume_});
   ++system_builds_;
   system_rebuild_requested_ = false;
 }

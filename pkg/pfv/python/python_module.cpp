@@ -220,6 +220,9 @@ PYBIND11_MODULE(_core, m) {
            exclusive([](const SharedEngine& e) { return e.cholesky() ? e.cholmod().factor_flops() : 0.0; }))
       .def_property("fluid_bulk_modulus", get_setting(&EngineSettings::fluid_bulk_modulus),
                     set_setting(&EngineSettings::fluid_bulk_modulus))
+      .def_property("minimum_porosity", get_setting(&EngineSettings::minimum_porosity),
+                    set_setting(&EngineSettings::minimum_porosity),
+                    "A compressible cell stores at least minimum_porosity times its volume (YADE's minimumPorosity).")
       .def_property("background_remesh", get_setting(&EngineSettings::background_remesh),
                     set_setting(&EngineSettings::background_remesh))
       .def_property("viscous_shear", get_setting(&EngineSettings::viscous_shear),
@@ -385,4 +388,5 @@ PYBIND11_MODULE(_core, m) {
       .def("remesh_times", exclusive([](const SharedEngine& e) { return times_dict(e.remesh_times()); }))
       .def("step_times", exclusive([](const SharedEngine& e) { return times_dict(e.step_times()); }));
   bind_geometry(engine);
+  bind_cells(engine);
 }

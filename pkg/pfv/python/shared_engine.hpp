@@ -114,5 +114,6 @@ using EngineClass = py::class_<SharedEngine>;
 
 // The binding groups of pfv.Engine defined in files of their own (python_module.cpp calls them).
 void bind_geometry(EngineClass& engine);  // geometry_bindings.cpp
+void bind_cells(EngineClass& engine);     // cell_bindings.cpp
 
 }  // namespace pfv::python

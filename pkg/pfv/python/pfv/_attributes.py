@@ -36,6 +36,7 @@ CORE_NAME: dict[str, str] = {
     "pZero": "p_zero",
     "multithread": "background_remesh",
     "fluidBulkModulus": "fluid_bulk_modulus",
+    "minimumPorosity": "minimum_porosity",
     "viscousShear": "viscous_shear",
     # PFV extensions (PEP 8 names: YADE has no equivalent).
     "mixed_precision": "mixed_precision",

@@ -9,9 +9,9 @@ An attribute YADE's FlowEngine has but PFV does not support may only be set to Y
 default value; any other value raises NotImplementedError naming it. Misspelt names raise
 AttributeError. Nothing is silently ignored.
 
-This module holds the engine class, which composes three parts: the attribute surface
-(``_attributes``), the scan of YADE's bodies (``_scene_scan.SceneScan``) and the time-step
-guard (``_time_step.TimeStepGuard``).
+This module holds the engine class, which composes four parts: the attribute surface
+(``_attributes``), the scan of YADE's bodies (``_scene_scan.SceneScan``), the time-step
+guard (``_time_step.TimeStepGuard``) and the members on single cells (``_cell_interface``, a mixin).
 """
 from __future__ import annotations
 
@@ -33,6 +33,7 @@ from yade.wrapper import PyRunner
 from yade.minieigenHP import Vector3
 
 from . import _attributes as attributes
+from ._cell_interface import CELL_INTERNAL, CellInterface
 from ._core import Engine, set_num_threads
 from ._scene_scan import SceneScan
 from ._time_step import TimeStepGuard, TimeStepWarning, viscous_time_step
@@ -89,7 +90,7 @@ _INTERNAL = frozenset({
     "_warned",                # the one-time warnings given
     "_threads",               # ompThreads, None: follow YADE's -j
     "_use_sphere_pack",       # False: always read the coordinate lists
-})
+}) | CELL_INTERNAL
 
 
 def _exclusive(method):
@@ -108,7 +109,7 @@ def _guard_setting(name: str, doc: str) -> property:
                     doc=doc)
 
 
-class FlowEngine(PyRunner):
+class FlowEngine(CellInterface, PyRunner):
     """PFV's DEM-PFV flow engine with the interface of YADE's FlowEngine."""
 
     xmin, xmax, ymin, ymax, zmin, zmax = range(6)
@@ -550,6 +551,7 @@ class FlowEngine(PyRunner):
         return self._core
 
 
-# Names set as ordinary attributes: PyRunner's (command, iterPeriod, label, ...) and FlowEngine's properties.
+# Names set as ordinary attributes: PyRunner's (command, iterPeriod, label, ...) and the properties
+# of FlowEngine and its mixin.
 _OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
-    name for name, v in vars(FlowEngine).items() if isinstance(v, property)}
+    name for klass in FlowEngine.__mro__ for name, v in vars(klass).items() if isinstance(v, property)}

@@ -66,6 +66,10 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
        }},
       {"set_cell_imposed", [](FlowEngine& e) { e.set_cell_imposed(0, true); }},
       {"block_cell", [](FlowEngine& e) { e.block_cell(0, false); }},
+      {"pressure_profile",
+       [](FlowEngine& e) {
+         e.bc.profile = {3, 0, {0.0, 1.0}, {0.0, 1.0}};
+       }},
       {"bnd_value", [](FlowEngine& e) { e.bc.value = {1.0, 0.5, 0, 0, 0, 0}; }},
       {"tolerance", [](FlowEngine& e) { e.settings.tolerance = 1e-8; }},
       {"relax", [](FlowEngine& e) { e.settings.relax = 1.5; }},
@@ -76,6 +80,9 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
       {"def_tolerance", [](FlowEngine& e) { e.settings.def_tolerance = 0.5; }},
       {"p_zero", [](FlowEngine& e) { e.settings.p_zero = 1.0; }},
       {"minimum_porosity", [](FlowEngine& e) { e.settings.minimum_porosity = 0.1; }},
+      {"flat_threshold", [](FlowEngine& e) { e.settings.flat_threshold = 1e-6; }},
+      {"volume_correction", [](FlowEngine& e) { e.settings.volume_correction = 0.5; }},
+      {"interpolate_on_remesh", [](FlowEngine& e) { e.settings.interpolate_on_remesh = true; }},
       {"set_cell_pressure", [](FlowEngine& e) { e.set_cell_pressure(0, 0.5); }},
       {"background_remesh", [](FlowEngine& e) { e.settings.background_remesh = true; }},
   };

@@ -32,6 +32,10 @@ class FlowEngine {
   // system or non-finite results; the engine is unchanged by a step that throws.
   void step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
 
+  // Remeshes now at these positions (in the foreground) without building the linear system:
+  // the next step builds it, with the conditions set on the new cells meanwhile (YADE's blockHook
+  // runs in between). Throws as step() does for bad positions or settings.
+  void remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls);
   // The next step remeshes (in the foreground).
   void request_remesh() { remesh_requested_ = true; }
   // The next step rebuilds the linear system (YADE's updateBCs; changes of the boundary types,
@@ -141,9 +145,14 @@ class FlowEngine {
   double refinement_contraction() const;  // -1 until measured, or without a 32-bit factor
   const StageTimes& remesh_times() const { return remesh_times_; }
   const StageTimes& step_times() const { return step_times_; }
+  const StageTimes& system_times() const { return linear_.times; }  // assembly, analysis, factorization
 
  private:
-  using Remesh = std::pair<PoreMesh, LinearSystem>;
+  struct Remesh {
+    PoreMesh mesh;
+    LinearSystem linear;
+    CellConditions cells;  // those of a new mesh: its flat cells
+  };
   struct Pending {
     std::future<Remesh> result;
   };
@@ -166,7 +175,14 @@ class FlowEngine {
   void remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                             double dt);
   void remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
-  void adopt(PoreMesh&& mesh, LinearSystem&& linear);
+  // with_system: the linear system of the mesh (else an empty one, built at the next step).
+  void adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system = true);
+  // The conditions of a new mesh: its cells of at most settings.flat_threshold volume blocked.
+  static CellConditions flat_cells(const PoreMesh& mesh, const EngineSettings& settings);
+  // With settings.interpolates(), blocks the cells of the new mesh whose barycentres (at these
+  // positions) lie in a blocked cell of the current one; returns whether it blocked any.
+  bool carry_blocked_cells(const PoreMesh& mesh, CellConditions& conditions, const std::vector<Vec3>& centres,
+                           const BoxWalls& walls) const;
   // The current system's solver with its factor freed, handed over to the next build (the
   // storage of the factor's values is reused): peak memory one factor, no new pages to fault.
   std::unique_ptr<PressureSolver> released_solver();

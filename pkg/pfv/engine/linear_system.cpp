@@ -1,5 +1,7 @@
 #include "pfv/engine/linear_system.hpp"
 
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -60,7 +62,8 @@ SystemRecipe::SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc
       dt(step),
       is_pressure(bc.is_pressure),
       imposed_pressure_at(positions(bc.imposed_pressure)),
-      imposed_flux_at(positions(bc.imposed_flux)) {}
+      imposed_flux_at(positions(bc.imposed_flux)),
+      profile(bc.profile) {}
 
 bool SystemRecipe::stale_for(const EngineSettings& s, const BoundaryConditions& bc, double step) const {
   if (solver != s.solver || viscosity != s.conductance.viscosity || fluid_bulk_modulus != s.fluid_bulk_modulus ||
@@ -70,7 +73,8 @@ bool SystemRecipe::stale_for(const EngineSettings& s, const BoundaryConditions& 
   if (solver == SolverKind::kCholesky && (ordering != s.factor_ordering() || mixed_precision != s.mixed_precision ||
                                           mixed_precision_min_entries != s.mixed_precision_min_entries))
     return true;
-  if (imposed_pressure_at.size() != bc.imposed_pressure.size() || imposed_flux_at.size() != bc.imposed_flux.size())
+  if (imposed_pressure_at.size() != bc.imposed_pressure.size() || imposed_flux_at.size() != bc.imposed_flux.size() ||
+      !(profile == bc.profile))
     return true;
   for (std::size_t i = 0; i < imposed_pressure_at.size(); ++i)
     if (imposed_pressure_at[i] != bc.imposed_pressure[i].position) return true;
@@ -106,6 +110,14 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   l.system = assemble_pressure_system(m.mesh(), m.facets, m.k, bc, l.imposed_pressure_cells, l.storage,
                                       cells.conditions ? *cells.conditions : kNone);
   const PressureSystem& s = l.system;
+  if (!bc.profile.empty())
+    for (int c = 0; c < m.mesh().n_cells(); ++c)
+      if (s.source[c] == bc.profile.wall) {
+        // Beyond the profile's points the wall's value applies, read at every step as usual.
+        const double x = m.cells.power_centre[c][bc.profile.axis];
+        const double p = profile_pressure(bc.profile, x, std::numeric_limits<double>::quiet_NaN());
+        if (!std::isnan(p)) l.profile_pressure.emplace_back(c, p);
+      }
   for (int u = 0; u < s.n_unknowns(); ++u) {
     const int c = s.unknown_cell[u];
     for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e)

@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "pfv/engine/engine_settings.hpp"
@@ -32,6 +33,7 @@ struct SystemRecipe {
   double dt = 0;                // likewise
   std::array<bool, kWallCount> is_pressure{};
   std::vector<Vec3> imposed_pressure_at, imposed_flux_at;
+  PressureProfile profile;
 
   SystemRecipe() = default;
   SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc, double dt);
@@ -48,6 +50,8 @@ struct LinearSystem {
   std::shared_ptr<const CellOrdering> ordering;  // of a Cholesky factor, for the next remesh
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;
   std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid
+  // (cell, pressure) of the Dirichlet cells of bc.profile's wall; empty without a profile.
+  std::vector<std::pair<int, double>> profile_pressure;
   SystemRecipe recipe;
   StageTimes times;  // assembly, analysis, factorization
 

@@ -34,10 +34,14 @@ class SceneScan:
     `wall_ids` and `use_max_min` are the engine's wallIds and boundaryUseMaxMin; `use_sphere_pack`
     False always reads the coordinate lists; `warned` collects the one-time warnings of the engine;
     `previous` is the last scan, whose force bridge and position array are reused when they fit.
+    YADE's `mask` (> 0: only spheres whose groupMask shares a bit with it), `convert_clumps` (False:
+    clump members are coupled as spheres, the clumps left out) and `wall_thickness` (> 0: a wall
+    body bounds the domain at this half thickness from its centre) are applied as YADE does.
     """
 
     def __init__(self, wall_ids: Sequence[int], use_max_min: Sequence[bool], *, use_sphere_pack: bool = True,
-                 warned: set[str] | None = None, previous: SceneScan | None = None) -> None:
+                 warned: set[str] | None = None, previous: SceneScan | None = None, mask: int = 0,
+                 convert_clumps: bool = True, wall_thickness: float = 0.0) -> None:
         scene = yade.O
         if scene.periodic:
             raise NotImplementedError("pfv.FlowEngine does not support periodic scenes yet")
@@ -59,7 +63,11 @@ class SceneScan:
             pack_size += is_sphere
             if bid in wall_set:
                 continue
-            if is_clump or b.isClumpMember:
+            if mask > 0 and not b.groupMask & mask:
+                continue  # not affected by this engine (YADE leaves it out of the triangulation)
+            if is_clump and not convert_clumps:
+                continue  # its members are coupled instead (NewtonIntegrator sums their forces)
+            if is_clump or (b.isClumpMember and convert_clumps):
                 clumps += 1
             elif is_sphere:
                 radius = shape.radius
@@ -83,7 +91,8 @@ class SceneScan:
                              f"({len(row_of)} bodies, walls wallIds = {self.wall_ids})")
         if clumps:
             raise NotImplementedError(
-                f"pfv.FlowEngine does not support clumps yet ({clumps} clump bodies or members in the scene)")
+                f"pfv.FlowEngine does not support clumps yet with convertClumps=True ({clumps} clump bodies or "
+                "members in the scene); convertClumps=False couples the members as spheres")
         if warned is None:
             warned = set()
         if others and "others" not in warned:
@@ -105,8 +114,11 @@ class SceneScan:
                 raise ValueError(f"wallIds[{w}] = {bid} names a {type(b.shape).__name__} body, not a wall "
                                  "(a Box, Wall or Facet)")
             wall_rows.append(row_of[bid])
-            # A box wall bounds the domain with its inner face.
-            half = b.shape.extents[w // 2] if isinstance(b.shape, Box) else 0.0
+            # A box wall bounds the domain with its inner face, unless wallThickness says where.
+            if wall_thickness > 0:
+                half = 0.5 * wall_thickness
+            else:
+                half = b.shape.extents[w // 2] if isinstance(b.shape, Box) else 0.0
             wall_half.append(-half if w % 2 else half)
         vertex_of_id = {bid: k for k, bid in enumerate(ids)}
         for w, bid in enumerate(self.wall_ids):

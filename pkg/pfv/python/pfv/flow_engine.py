@@ -83,7 +83,7 @@ _INTERNAL = frozenset({
     "_scan",                  # the last SceneScan, None before the first step
     "_stepped",               # the SceneScan of the last successful step: the current mesh's spheres
     "_scene_tag",             # the value this engine left in O.tags: a new scene lacks it
-    "_last_step",             # (O.iter, O.time) of the last successful step, None: no history
+    "_last_step",             # (O.iter, O.time, dt) of the last successful step, None: no history
     "_guard",                 # the TimeStepGuard
     "_boundary_use_max_min",  # boundaryUseMaxMin
     "_wall_ids",              # wallIds
@@ -247,8 +247,9 @@ class FlowEngine(CellInterface, PyRunner):
     # -- the step ---------------------------------------------------------------------------
     def _rescan(self) -> SceneScan:
         """Scan the bodies again (sphere ids, radii, masses, walls); done at each remesh (bodies may change)."""
+        self._apply_id_offset()
         self._scan = SceneScan(self._wall_ids, self._boundary_use_max_min, use_sphere_pack=self._use_sphere_pack,
-                               warned=self._warned, previous=self._scan)
+                               warned=self._warned, previous=self._scan, **self._scan_options())
         return self._scan
 
     def _scanned(self) -> SceneScan:
@@ -313,6 +314,8 @@ class FlowEngine(CellInterface, PyRunner):
 
     @_exclusive
     def _step(self) -> None:
+        if not self._pressure_force:  # YADE's pressureForce=False: no flow at all
+            return
         scene = yade.O
         core = self._core
         self._notice_new_scene(scene)
@@ -336,10 +339,15 @@ class FlowEngine(CellInterface, PyRunner):
         self._check_time_step(scene.dt, scan, collective=self._guard.known_limit(core))
         remeshing = core.remesh_due()
         inversions = core.inversion_remeshes
+        before = (core.remesh_count, core.system_builds) if self._after_step_reports else None
+        if self._desired_porosity:
+            self._correct_volumes(pos, scan.radii)
         with self._bodies_named(scan):
+            if self._block_hook and remeshing and not core.background_remesh:
+                self._remesh_for_block_hook(pos, scan, walls)  # blockHook, between the mesh and its system
             core.step(pos, scan.radii, walls, dt)
         self._stepped = scan
-        self._last_step = (scene.iter, scene.time)
+        self._last_step = (scene.iter, scene.time, dt)  # dt: the time this step's dV/dt spanned
         _holding.add(self._key)
         _release_unused(self)
         if self._guard.stale(core):
@@ -364,8 +372,11 @@ class FlowEngine(CellInterface, PyRunner):
                 warnings.warn(f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
                               f"regular triangulation and get no fluid force (ids {yade_ids}...)",
                               stacklevel=2)
+        if self._after_step_reports:
+            self._report_step(before)
         # The engine's force array is read in C++, without a numpy copy.
-        scan.force_bridge.apply(scene.forces.addF, core)
+        if not self._decouple_forces:
+            scan.force_bridge.apply(scene.forces.addF, core)
 
     @contextlib.contextmanager
     def _bodies_named(self, scan: SceneScan):

@@ -310,6 +310,48 @@ FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells
   return g;
 }
 
+int find_facet(const FacetGeometry& g, const Mesh& mesh, int cell, int local) {
+  const int other = mesh.cell_neighbours[cell][local];
+  // The owner is the lower-numbered cell (or the only one); its facets are contiguous.
+  const int owner = other >= 0 && other < cell ? other : cell;
+  const auto first = std::lower_bound(g.cell.begin(), g.cell.end(), owner,
+                                      [](const std::array<int, 2>& c, int x) { return c[0] < x; });
+  for (auto it = first; it != g.cell.end() && (*it)[0] == owner; ++it) {
+    const std::size_t f = static_cast<std::size_t>(it - g.cell.begin());
+    if (owner == cell ? g.local[f][0] == local : (g.cell[f][1] == cell && g.local[f][1] == local))
+      return static_cast<int>(f);
+  }
+  return -1;
+}
+
+std::array<double, 3> half_throat_wetted_area(const Mesh& mesh, const CellGeometry& cells, const Packing& pk, int cell,
+                                              int local, const std::array<bool, kWallCount>& solid_wall) {
+  std::array<double, 3> wetted{};
+  const auto v = facet_vertices(mesh, cell, local);
+  const FacetPolygon poly = make_polygon(mesh, v, pk);
+  const double area = poly.area.norm();
+  if (poly.n_real == 0 || area <= 0) return wetted;
+  Vec3 S = poly.area;
+  if (S.dot(away_from(mesh, poly, mesh.cell_vertices[cell][local], pk)) < 0) S = -S;
+  const Vec3& apex = cells.power_centre[cell];
+  // The apex lies on the cell's side of the facet unless the height is negative.
+  const double sign = -(S / area).dot(apex - pk.centre[poly.real[0]]) >= 0 ? 1.0 : -1.0;
+  for (int r = 0; r < poly.n_real; ++r) {
+    const Vec3& x = pk.centre[poly.real[r]];
+    const double rad = pk.radius[poly.real[r]];
+    const Vec3 to_apex = apex - x;
+    if (to_apex.squaredNorm() == 0) continue;
+    wetted[poly.slot[r]] += sign * solid_angle(poly.edge[r][0], poly.edge[r][1], unit_or_zero(to_apex)) * rad * rad;
+  }
+  for (int w = 0; w < poly.n_walls; ++w) {
+    if (!solid_wall[poly.wall[w]]) continue;
+    const auto& e = poly.wall_edge[w];
+    wetted[poly.wall_slot[w]] += sign * 0.5 * (e[1] - e[0]).cross(apex - e[0]).norm();
+  }
+  for (double& x : wetted) x = std::max(0.0, x);
+  return wetted;
+}
+
 std::array<Vec3, 4> wall_footprints(const Mesh& mesh, int cell, const Packing& pk) {
   std::array<Vec3, 4> out;
   for (int l = 0; l < 4; ++l) {

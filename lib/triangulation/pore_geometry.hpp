@@ -74,6 +74,18 @@ CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& packing);
 FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells, const Packing& packing,
                                      bool slip_boundary);
 
+// The facet of the current geometry opposite local vertex 'local' of 'cell' (-1 if none): each
+// facet is stored once, from its lower-numbered pore cell, facets of a cell contiguous.
+int find_facet(const FacetGeometry& facets, const Mesh& mesh, int cell, int local);
+
+// The solid surface of the half throat on the side of 'cell': the part of the throat
+// bipyramid between the facet opposite its local vertex 'local' and the cell's power centre.
+// Entry k is for vertex k of the facet (the cell's vertices without 'local', in order): the
+// spherical triangle of a sphere; for a wall, its area in the half throat if solid_wall[w]
+// (else 0). Signed half pyramids are counted as compute_facet_geometry counts them, floored at 0.
+std::array<double, 3> half_throat_wetted_area(const Mesh& mesh, const CellGeometry& cells, const Packing& packing,
+                                              int cell, int local, const std::array<bool, kWallCount>& solid_wall);
+
 // Projected area of a cell on each of its walls, as outward force vectors per unit
 // pressure (the wall part of the force cache). Entry k is for local vertex k of the cell;
 // sphere vertices get zero.

@@ -64,6 +64,12 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
        [](FlowEngine& e) {
          e.bc.imposed_flux.push_back({Vec3(0.5, 0.5, 0.5), -1e-3});
        }},
+      {"set_cell_imposed", [](FlowEngine& e) { e.set_cell_imposed(0, true); }},
+      {"block_cell", [](FlowEngine& e) { e.block_cell(0, false); }},
+      {"pressure_profile",
+       [](FlowEngine& e) {
+         e.bc.profile = {3, 0, {0.0, 1.0}, {0.0, 1.0}};
+       }},
       {"bnd_value", [](FlowEngine& e) { e.bc.value = {1.0, 0.5, 0, 0, 0, 0}; }},
       {"tolerance", [](FlowEngine& e) { e.settings.tolerance = 1e-8; }},
       {"relax", [](FlowEngine& e) { e.settings.relax = 1.5; }},
@@ -75,6 +81,11 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
       {"p_zero", [](FlowEngine& e) { e.settings.p_zero = 1.0; }},
       {"fluid_density", [](FlowEngine& e) { e.settings.fluid_density = 1000.0; }},
       {"gravity", [](FlowEngine& e) { e.settings.gravity = Vec3(0.0, -9.81, 0.0); }},
+      {"minimum_porosity", [](FlowEngine& e) { e.settings.minimum_porosity = 0.1; }},
+      {"flat_threshold", [](FlowEngine& e) { e.settings.flat_threshold = 1e-6; }},
+      {"volume_correction", [](FlowEngine& e) { e.settings.volume_correction = 0.5; }},
+      {"interpolate_on_remesh", [](FlowEngine& e) { e.settings.interpolate_on_remesh = true; }},
+      {"set_cell_pressure", [](FlowEngine& e) { e.set_cell_pressure(0, 0.5); }},
       {"background_remesh", [](FlowEngine& e) { e.settings.background_remesh = true; }},
   };
   return table;

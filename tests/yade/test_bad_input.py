@@ -49,7 +49,7 @@ expect_error("unknown constructor keyword", AttributeError, "pressureeForce", la
 expect_error("YADE attribute not supported", NotImplementedError, "normalLubrication",
              lambda: setattr(flow, "normalLubrication", True))
 flow.normalLubrication = False  # YADE's default is accepted
-expect_error("YADE method not supported", NotImplementedError, "exportMatrix", lambda: flow.exportMatrix("/tmp/x"))
+expect_error("YADE method out of scope", NotImplementedError, "getCavityFlux", lambda: flow.getCavityFlux())
 expect_error("non-positive viscosity", ValueError, "viscosity", lambda: setattr(flow, "viscosity", -1.0))
 expect_error("NaN viscosity", ValueError, "viscosity", lambda: setattr(flow, "viscosity", float("nan")))
 expect_error("query before any step", RuntimeError, "not run yet", lambda: flow.getBoundaryFlux(2))

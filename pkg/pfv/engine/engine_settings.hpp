@@ -47,6 +47,19 @@ struct EngineSettings {
   // cell stores fluid: (V_f / K) dp/dt enters continuity (implicit Euler), which adds
   // V_f / (K dt) to the diagonal of G; the system is then rebuilt when dt changes.
   double fluid_bulk_modulus = 0;
+  // The pore volume a compressible cell stores is at least minimum_porosity times its total
+  // volume (YADE's minimumPorosity; cell_queries.hpp), in [0, 1).
+  double minimum_porosity = 0;
+  // dV/dt of the cells without wall vertices is multiplied by volume_correction (YADE's
+  // volumeCorrection, which its desiredPorosity sets at each step), positive.
+  double volume_correction = 1;
+  // At a remesh, cells whose volume is at most flat_threshold are blocked (YADE's flatThreshold;
+  // negative: none). A change applies from the next remesh.
+  double flat_threshold = -1;
+  // At a remesh, carry the pressures and the blocked cells of the old mesh over to the new cells
+  // (located at their power centres) even for an incompressible fluid solved directly (YADE's
+  // doInterpolate): the iterative solvers and a compressible fluid always carry them.
+  bool interpolate_on_remesh = false;
   // Remesh on a second thread from a snapshot while steps go on with the old mesh (YADE's
   // `multithread`): the new mesh arrives a few steps late.
   bool background_remesh = false;
@@ -61,6 +74,10 @@ struct EngineSettings {
 
   SolveControl solve_control() const {
     return {tolerance, relax, max_iterations, refinement_tolerance, max_refinement_passes};
+  }
+  // Whether a remesh carries the old mesh's cell states over (see interpolate_on_remesh).
+  bool interpolates() const {
+    return solver != SolverKind::kCholesky || fluid_bulk_modulus > 0 || interpolate_on_remesh;
   }
   // The ordering CHOLMOD is asked for.
   Ordering factor_ordering() const { return force_metis ? Ordering::kMetis : ordering; }

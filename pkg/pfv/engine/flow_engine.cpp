@@ -11,6 +11,7 @@
 #include "pfv/common/parallel.hpp"
 #include "pfv/common/stage_timer.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
+#include "pfv/model/cell_queries.hpp"
 #include "pfv/snapshot/snapshot.hpp"
 
 namespace pfv {
@@ -34,6 +35,8 @@ void FlowEngine::release() {
     std::vector<double>().swap(*v);
   for (auto* v : {&force_, &next_force_, &shear_force_, &next_shear_, &centres_prev_}) std::vector<Vec3>().swap(*v);
   has_prev_ = keep_trend_ = false;
+  cells_.clear();
+  std::vector<double>().swap(measured_void_volume_);
   strain_ = 0;
   steps_since_remesh_ = 0;
   remesh_requested_ = true;
@@ -162,7 +165,10 @@ void FlowEngine::adopt_finished_remesh() {
     remesh_requested_ = true;  // the next step remeshes in the foreground and says why
     throw;
   }
-  adopt(std::move(r->first), std::move(r->second));
+  // The worker could not see the old mesh: blocked cells carried over now need a new system.
+  const bool carried = carry_blocked_cells(r->mesh, r->cells, centres_prev_, walls_prev_);
+  adopt(std::move(r->mesh), std::move(r->linear), std::move(r->cells));
+  if (carried) system_rebuild_requested_ = true;
 }
 
 void FlowEngine::remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii,
@@ -171,8 +177,9 @@ void FlowEngine::remesh_in_background(const std::vector<Vec3>& centres, const st
   pending_ = Pending{std::async(std::launch::async,
                                 [c = centres, r = radii, w = walls, s = settings, b = bc, dt, o = linear_.ordering]() {
                                   PoreMesh m = build_pore_mesh(c, r, w, s);
-                                  LinearSystem l = build_linear_system(m, b, s, dt, o.get());
-                                  return Remesh(std::move(m), std::move(l));
+                                  CellConditions flat = flat_cells(m, s);
+                                  LinearSystem l = build_linear_system(m, b, s, dt, o.get(), nullptr, {&flat});
+                                  return Remesh{std::move(m), std::move(l), std::move(flat)};
                                 })};
   strain_ = 0;
   steps_since_remesh_ = 0;
@@ -185,16 +192,65 @@ void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<
     pending_.reset();
   }
   PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
+  CellConditions conditions = flat_cells(m, settings);
+  carry_blocked_cells(m, conditions, centres, walls);
   // Free the old factor first (the largest object: peak memory is then one factor, not two).
   // Should the new system fail, the old mesh is kept without a solver and the next step starts
   // the remesh over; the last results stay readable meanwhile.
   remesh_requested_ = true;
   const auto ordering = linear_.ordering;  // survives the release of the old factor
-  LinearSystem l = build_linear_system(m, bc, settings, dt, ordering.get(), released_solver());
-  adopt(std::move(m), std::move(l));
+  LinearSystem l = build_linear_system(m, bc, settings, dt, ordering.get(), released_solver(), {&conditions});
+  adopt(std::move(m), std::move(l), std::move(conditions));
   strain_ = 0;
   steps_since_remesh_ = 0;
   remesh_requested_ = false;
+}
+
+void FlowEngine::remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls) {
+  validate(settings);
+  validate(bc);
+  validate_snapshot(centres, radii, walls);
+  if (pending_) {  // superseded by this one
+    pending_->result.wait();
+    pending_.reset();
+  }
+  PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
+  CellConditions conditions = flat_cells(m, settings);
+  carry_blocked_cells(m, conditions, centres, walls);
+  // No system yet: the next step builds it, with the conditions set on the new cells meanwhile.
+  LinearSystem none;
+  none.ordering = linear_.ordering;
+  adopt(std::move(m), std::move(none), std::move(conditions), false);
+  strain_ = 0;
+  steps_since_remesh_ = 0;
+  remesh_requested_ = false;
+}
+
+CellConditions FlowEngine::flat_cells(const PoreMesh& m, const EngineSettings& s) {
+  CellConditions c;
+  if (s.flat_threshold < 0) return c;
+  const int n = m.mesh().n_cells();
+  for (int k = 0; k < n; ++k)
+    if (m.cells.volume[k] <= s.flat_threshold) c.block(k, n);
+  return c;
+}
+
+bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditions, const std::vector<Vec3>& centres,
+                                     const BoxWalls& walls) const {
+  if (!has_mesh() || cells_.blocked.empty() || !settings.interpolates()) return false;
+  if (centres.size() != static_cast<std::size_t>(m.mesh().n_spheres)) return false;
+  bool carried = false;
+  const int n = m.mesh().n_cells();
+  const std::vector<double> no_radii;
+  const Packing packing{centres, no_radii, walls};
+  for (int k = 0; k < n; ++k) {
+    // The barycentre lies inside the new cell (a power centre need not).
+    const int old = mesh_->tri.locate(cell_barycenter(m.cells.shape[k], packing));
+    if (old < 0 || !cells_.is_blocked(old)) continue;
+    carried |= conditions.block(k, n);
+    conditions.set_pressure(k, cells_.pressure_of(old), n);
+  }
+  return carried;
 }
 
 std::unique_ptr<PressureSolver> FlowEngine::released_solver() {
@@ -203,15 +259,19 @@ std::unique_ptr<PressureSolver> FlowEngine::released_solver() {
   return solver;
 }
 
-void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear) {
+void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system) {
   // The old pressure at the new pore centres: the state of a compressible fluid, and the warm
-  // start of the iterative solvers. (The direct solve of an incompressible fluid needs neither.)
+  // start of the iterative solvers. (The direct solve of an incompressible fluid needs neither,
+  // unless asked for: interpolate_on_remesh.)
   std::vector<double> pressure(mesh.mesh().n_cells(), settings.p_zero);
-  if ((settings.solver != SolverKind::kCholesky || settings.fluid_bulk_modulus > 0) && has_mesh())
+  if (settings.interpolates() && has_mesh())
     for (int c = 0; c < mesh.mesh().n_cells(); ++c) {
       const int old = mesh_->tri.locate(mesh.cells.power_centre[c]);
       if (old >= 0) pressure[c] = pressure_[old];
     }
+  // A cell blocked at zero pressure holds zero (a flat cell, or one carried over, keeps its pressure).
+  for (int c = 0; c < mesh.mesh().n_cells(); ++c)
+    if (conditions.is_blocked(c) && conditions.pressure_of(c) == CellPressure::kImposed) pressure[c] = 0;
   // A solver built elsewhere (a background remesh) learns what the current one has.
   CholeskySolver* next = linear.cholesky();
   const CholeskySolver* current = linear_.cholesky();
@@ -224,7 +284,9 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear) {
   mesh_ = std::make_unique<PoreMesh>(std::move(mesh));
   linear_ = std::move(linear);
   pressure_ = std::move(pressure);
-  pressure_before_.clear();  // other cells
+  pressure_before_.clear();        // other cells
+  cells_ = std::move(conditions);  // those of the old cells named cells by index: gone
+  std::vector<double>().swap(measured_void_volume_);
   const int nc = mesh_->mesh().n_cells();
   volume_.assign(mesh_->cells.volume.begin(), mesh_->cells.volume.end());
   volume_rate_.assign(nc, 0.0);
@@ -234,7 +296,7 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear) {
   else
     has_prev_ = false;  // bodies appeared or vanished: no backward difference this step
   ++remesh_count_;
-  ++system_builds_;
+  if (with_system) ++system_builds_;
 }
 
 void FlowEngine::rebuild_stale_system(double dt) {
@@ -243,7 +305,8 @@ void FlowEngine::rebuild_stale_system(double dt) {
   if (mesh_->viscosity() != settings.conductance.viscosity) mesh_->set_viscosity(settings.conductance.viscosity);
   if (linear_.ready() && !system_rebuild_requested_ && !linear_.recipe.stale_for(settings, bc, dt)) return;
   const auto ordering = linear_.ordering;
-  linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver());
+  linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver(),
+                                {&cells_, &measured_void_volume_});
   ++system_builds_;
   system_rebuild_requested_ = false;
 }
@@ -273,6 +336,9 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
     next_volume_[c] = v;
   }
   inverted_cells_ = inverted_cells;
+  if (settings.volume_correction != 1)
+    for (int c = 0; c < nc; ++c)
+      if (mesh_->cells.shape[c].n_walls == 0) volume_rate_[c] *= settings.volume_correction;
   step_times_.volumes = seconds_since(t0);
 
   // b = -dV/dt (+ V_f/(K dt) p^n, implicit Euler on the stored fluid) + imposed fluxes + the
@@ -280,6 +346,7 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   next_pressure_ = pressure_;  // the iterative solvers' start
   const PressureSystem& system = linear_.system;
   apply_dirichlet_values(system, bc, next_pressure_);
+  for (const auto& [c, p] : linear_.profile_pressure) next_pressure_[c] = p;
   const int nu = system.n_unknowns();
   rhs_.resize(nu);
   for (int u = 0; u < nu; ++u) rhs_[u] = -volume_rate_[system.unknown_cell[u]];

@@ -12,6 +12,7 @@
 #include "pfv/engine/pore_mesh.hpp"
 #include "pfv/engine/stage_times.hpp"
 #include "pfv/model/boundary_conditions.hpp"
+#include "pfv/model/cell_conditions.hpp"
 
 namespace pfv {
 
@@ -31,6 +32,10 @@ class FlowEngine {
   // system or non-finite results; the engine is unchanged by a step that throws.
   void step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
 
+  // Remeshes now at these positions (in the foreground) without building the linear system:
+  // the next step builds it, with the conditions set on the new cells meanwhile (YADE's blockHook
+  // runs in between). Throws as step() does for bad positions or settings.
+  void remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls);
   // The next step remeshes (in the foreground).
   void request_remesh() { remesh_requested_ = true; }
   // The next step rebuilds the linear system (YADE's updateBCs; changes of the boundary types,
@@ -90,6 +95,34 @@ class FlowEngine {
   void apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,
                               std::vector<Vec3>& accel) const;
 
+  // Conditions on single cells of the current mesh (YADE's setCellPImposed, setCellPressure,
+  // blockCell; cell_conditions.hpp). A remesh clears them, as it renumbers the cells. A change
+  // rebuilds the linear system at the next step; cells are checked by the caller.
+  // imposed: the cell's pressure is imposed at the value it holds (else it is an unknown even
+  // where a boundary would impose it).
+  void set_cell_imposed(int cell, bool imposed);
+  // Whether the cell's pressure is imposed: by its own condition, else by a pressure wall or an
+  // imposed point of the current boundary conditions (a blocked cell: blocked with its pressure).
+  bool cell_imposed(int cell) const;
+  // The pressure the cell holds: the value an imposed cell keeps, the state a compressible
+  // cell starts the next step from; an unknown of an incompressible fluid is solved anew.
+  // Throws std::invalid_argument if p is not finite.
+  void set_cell_pressure(int cell, double p);
+  // Cuts the cell out of the flow problem (no flux through its throats); its pressure stays
+  // as it is, or is set to zero and counted as imposed with zero_pressure.
+  void block_cell(int cell, bool zero_pressure);
+  const CellConditions& cell_conditions() const { return cells_; }
+  // The pore volume each cell stores (V_f floored at minimum_porosity V; cell_queries.hpp): of
+  // the mesh, or as measured by the last initialize_volumes since the remesh.
+  std::vector<double> void_volumes() const;
+  // YADE's initializeVolumes: the stored pore volumes are measured again at these positions
+  // (the sphere sectors of the mesh kept), and the next step starts without a dV/dt term.
+  void initialize_volumes(const std::vector<Vec3>& centres, const BoxWalls& walls);
+  // YADE's updateVolumes: the volume rates become those from the last step's positions to
+  // these, which become the reference of the next step's dV/dt. Throws std::invalid_argument
+  // for positions of another number of spheres, or a dt that is not positive.
+  void update_volumes(const std::vector<Vec3>& centres, const BoxWalls& walls, double dt);
+
   // Results of the last step.
   const std::vector<Vec3>& forces() const { return force_; }  // spheres, then six walls
   // The viscous shear part of forces() (empty while viscous_shear is off; zero on a step
@@ -98,6 +131,9 @@ class FlowEngine {
   // The pairs of the current mesh, or nullptr while viscous_shear is off.
   const ViscousShear* viscous_shear() const { return mesh_ && mesh_->shear ? &*mesh_->shear : nullptr; }
   const std::vector<double>& pressure() const { return pressure_; }
+  const std::vector<double>& volume_rates() const { return volume_rate_; }  // dV/dt per cell
+  // The positions of the last step (of the last update_volumes, if later).
+  const std::vector<Vec3>& last_centres() const { return centres_prev_; }
   const Mesh& mesh() const { return mesh_->mesh(); }
   const CellGeometry& cells() const { return mesh_->cells; }
   const FacetGeometry& facets() const { return mesh_->facets; }
@@ -128,9 +164,14 @@ class FlowEngine {
   double refinement_contraction() const;  // -1 until measured, or without a 32-bit factor
   const StageTimes& remesh_times() const { return remesh_times_; }
   const StageTimes& step_times() const { return step_times_; }
+  const StageTimes& system_times() const { return linear_.times; }  // assembly, analysis, factorization
 
  private:
-  using Remesh = std::pair<PoreMesh, LinearSystem>;
+  struct Remesh {
+    PoreMesh mesh;
+    LinearSystem linear;
+    CellConditions cells;  // those of a new mesh: its flat cells
+  };
   struct Pending {
     std::future<Remesh> result;
   };
@@ -147,10 +188,20 @@ class FlowEngine {
   void commit(const std::vector<Vec3>& centres, const BoxWalls& walls, double strain);
 
   void adopt_finished_remesh();
+  // The volume of every cell at these positions; throws std::invalid_argument if they do not
+  // belong to the mesh's spheres.
+  std::vector<double> volumes_at(const std::vector<Vec3>& centres, const BoxWalls& walls) const;
   void remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                             double dt);
   void remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
-  void adopt(PoreMesh&& mesh, LinearSystem&& linear);
+  // with_system: the linear system of the mesh (else an empty one, built at the next step).
+  void adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system = true);
+  // The conditions of a new mesh: its cells of at most settings.flat_threshold volume blocked.
+  static CellConditions flat_cells(const PoreMesh& mesh, const EngineSettings& settings);
+  // With settings.interpolates(), blocks the cells of the new mesh whose barycentres (at these
+  // positions) lie in a blocked cell of the current one; returns whether it blocked any.
+  bool carry_blocked_cells(const PoreMesh& mesh, CellConditions& conditions, const std::vector<Vec3>& centres,
+                           const BoxWalls& walls) const;
   // The current system's solver with its factor freed, handed over to the next build (the
   // storage of the factor's values is reused): peak memory one factor, no new pages to fault.
   std::unique_ptr<PressureSolver> released_solver();
@@ -176,6 +227,8 @@ class FlowEngine {
   int inversion_remeshes_ = 0;
   int system_builds_ = 0;
   SolveStats last_solve_;
+  CellConditions cells_;                      // of the current mesh
+  std::vector<double> measured_void_volume_;  // of the current mesh, by initialize_volumes (else empty)
   bool remesh_requested_ = true;
   bool system_rebuild_requested_ = false;
   StageTimes remesh_times_, step_times_;

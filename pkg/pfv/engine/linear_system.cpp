@@ -1,5 +1,7 @@
 #include "pfv/engine/linear_system.hpp"
 
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -7,6 +9,7 @@
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/linalg/gauss_seidel_solver.hpp"
 #include "pfv/linalg/pcg_solver.hpp"
+#include "pfv/model/cell_queries.hpp"
 #include "pfv/snapshot/snapshot.hpp"
 
 namespace pfv {
@@ -70,20 +73,23 @@ SystemRecipe::SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc
       mixed_precision(s.mixed_precision),
       mixed_precision_min_entries(s.mixed_precision_min_entries),
       fluid_bulk_modulus(s.fluid_bulk_modulus),
+      minimum_porosity(s.minimum_porosity),
       dt(step),
       is_pressure(bc.is_pressure),
       imposed_pressure_at(positions(bc.imposed_pressure)),
-      imposed_flux_at(positions(bc.imposed_flux)) {}
+      imposed_flux_at(positions(bc.imposed_flux)),
+      profile(bc.profile) {}
 
 bool SystemRecipe::stale_for(const EngineSettings& s, const BoundaryConditions& bc, double step) const {
   if (solver != s.solver || viscosity != s.conductance.viscosity || fluid_bulk_modulus != s.fluid_bulk_modulus ||
       is_pressure != bc.is_pressure)
     return true;
-  if (fluid_bulk_modulus > 0 && dt != step) return true;
+  if (fluid_bulk_modulus > 0 && (dt != step || minimum_porosity != s.minimum_porosity)) return true;
   if (solver == SolverKind::kCholesky && (ordering != s.factor_ordering() || mixed_precision != s.mixed_precision ||
                                           mixed_precision_min_entries != s.mixed_precision_min_entries))
     return true;
-  if (imposed_pressure_at.size() != bc.imposed_pressure.size() || imposed_flux_at.size() != bc.imposed_flux.size())
+  if (imposed_pressure_at.size() != bc.imposed_pressure.size() || imposed_flux_at.size() != bc.imposed_flux.size() ||
+      !(profile == bc.profile))
     return true;
   for (std::size_t i = 0; i < imposed_pressure_at.size(); ++i)
     if (imposed_pressure_at[i] != bc.imposed_pressure[i].position) return true;
@@ -96,25 +102,41 @@ const CholeskySolver* LinearSystem::cholesky() const { return dynamic_cast<const
 CholeskySolver* LinearSystem::cholesky() { return dynamic_cast<CholeskySolver*>(solver.get()); }
 
 LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc, const EngineSettings& settings,
-                                 double dt, const CellOrdering* previous, std::unique_ptr<PressureSolver> recycled) {
+                                 double dt, const CellOrdering* previous, std::unique_ptr<PressureSolver> recycled,
+                                 CellState cells) {
   LinearSystem l;
   l.recipe = SystemRecipe(settings, bc, dt);
   l.solver = recycled && recycled->kind() == settings.solver ? std::move(recycled) : make_solver(settings.solver);
   if (settings.fluid_bulk_modulus > 0) {
-    l.storage.resize(m.mesh().n_cells());
-    for (int c = 0; c < m.mesh().n_cells(); ++c)
-      l.storage[c] = m.cells.fluid_volume[c] / (settings.fluid_bulk_modulus * dt);
+    const int nc = m.mesh().n_cells();
+    const bool measured = cells.void_volume && static_cast<int>(cells.void_volume->size()) == nc;
+    l.storage.resize(nc);
+    for (int c = 0; c < nc; ++c) {
+      const double v = measured ? (*cells.void_volume)[c]
+                                : void_volume(m.cells.volume[c], m.cells.fluid_volume[c], settings.minimum_porosity);
+      l.storage[c] = v / (settings.fluid_bulk_modulus * dt);
+    }
   }
   l.imposed_pressure_cells = locate_points(m, bc.imposed_pressure, "imposed pressure");
   l.imposed_flux_cells = locate_points(m, bc.imposed_flux, "imposed flux");
 
   auto t0 = StageClock::now();
-  l.system = assemble_pressure_system(m.mesh(), m.facets, m.k, bc, l.imposed_pressure_cells, l.storage);
+  static const CellConditions kNone;
+  l.system = assemble_pressure_system(m.mesh(), m.facets, m.k, bc, l.imposed_pressure_cells, l.storage,
+                                      cells.conditions ? *cells.conditions : kNone);
   const PressureSystem& s = l.system;
+  if (!bc.profile.empty())
+    for (int c = 0; c < m.mesh().n_cells(); ++c)
+      if (s.source[c] == bc.profile.wall) {
+        // Beyond the profile's points the wall's value applies, read at every step as usual.
+        const double x = m.cells.power_centre[c][bc.profile.axis];
+        const double p = profile_pressure(bc.profile, x, std::numeric_limits<double>::quiet_NaN());
+        if (!std::isnan(p)) l.profile_pressure.emplace_back(c, p);
+      }
   for (int u = 0; u < s.n_unknowns(); ++u) {
     const int c = s.unknown_cell[u];
     for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e)
-      if (s.unknown[s.adj_cell[e]] < 0) {
+      if (s.unknown[s.adj_cell[e]] < 0 && s.adj_k[e] != 0) {  // no coupling through a blocked cell
         l.coupling_unknown.push_back(u);
         l.coupling_cell.push_back(s.adj_cell[e]);
         l.coupling_k.push_back(s.adj_k[e]);

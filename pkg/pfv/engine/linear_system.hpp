@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "pfv/engine/engine_settings.hpp"
@@ -13,6 +14,7 @@
 #include "pfv/linalg/ordering_reuse.hpp"
 #include "pfv/linalg/pressure_solver.hpp"
 #include "pfv/model/boundary_conditions.hpp"
+#include "pfv/model/cell_conditions.hpp"
 #include "pfv/model/pressure_system.hpp"
 
 namespace pfv {
@@ -27,9 +29,11 @@ struct SystemRecipe {
   bool mixed_precision = false;         // Cholesky only
   double mixed_precision_min_entries = 0;
   double fluid_bulk_modulus = 0;
-  double dt = 0;  // enters G only with a compressible fluid
+  double minimum_porosity = 0;  // enters G only with a compressible fluid
+  double dt = 0;                // likewise
   std::array<bool, kWallCount> is_pressure{};
   std::vector<Vec3> imposed_pressure_at, imposed_flux_at;
+  PressureProfile profile;
 
   SystemRecipe() = default;
   SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc, double dt);
@@ -46,6 +50,8 @@ struct LinearSystem {
   std::shared_ptr<const CellOrdering> ordering;  // of a Cholesky factor, for the next remesh
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;
   std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid
+  // (cell, pressure) of the Dirichlet cells of bc.profile's wall; empty without a profile.
+  std::vector<std::pair<int, double>> profile_pressure;
   SystemRecipe recipe;
   StageTimes times;  // assembly, analysis, factorization
 
@@ -55,6 +61,14 @@ struct LinearSystem {
   CholeskySolver* cholesky();
 };
 
+// What a linear system takes from the engine's state of the mesh's cells: the conditions set
+// on single cells, and the stored pore volumes when they were measured again since the remesh
+// (empty: from the mesh).
+struct CellState {
+  const CellConditions* conditions = nullptr;
+  const std::vector<double>* void_volume = nullptr;
+};
+
 // Throws std::domain_error if the system is singular, std::invalid_argument if an imposed point
 // lies in no pore cell. previous: the ordering of the last
 // factorisation, tried first when settings.reuse_ordering (null: compute one). recycled: the
@@ -62,6 +76,6 @@ struct LinearSystem {
 // it is of the kind the settings ask for.
 LinearSystem build_linear_system(const PoreMesh& mesh, const BoundaryConditions& bc, const EngineSettings& settings,
                                  double dt, const CellOrdering* previous = nullptr,
-                                 std::unique_ptr<PressureSolver> recycled = nullptr);
+                                 std::unique_ptr<PressureSolver> recycled = nullptr, CellState cells = {});
 
 }  // namespace pfv

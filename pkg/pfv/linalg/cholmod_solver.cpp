@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -78,6 +79,16 @@ double CholmodSolver::fill() const {
 }
 
 double CholmodSolver::factor_flops() const { return factor_ ? common_->c.fl : 0.0; }
+
+void CholmodSolver::print_statistics(const char* title) const {
+  cholmod_common* c = &common_->c;
+  const int quiet = c->print;
+  c->print = 3;
+  cholmod_print_common(title, c);
+  c->print = quiet;
+  std::printf("cholmod method: %d\nMETIS called: %d\n", c->selected, c->called_nd);
+  std::fflush(stdout);
+}
 
 namespace {
 

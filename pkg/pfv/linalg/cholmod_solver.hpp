@@ -82,6 +82,9 @@ class CholmodSolver {
   double factor_nonzeros() const;
   double factor_flops() const;
   double analysis_seconds() const { return analysis_seconds_; }  // ordering + symbolic
+  // CHOLMOD's report of its last analysis and factorisation (cholmod_print_common, on stdout)
+  // under 'title', then the ordering method selected and whether nested dissection ran.
+  void print_statistics(const char* title) const;
   // Frees the factor but keeps the storage of its values for the next factorize(), which
   // reuses it when the new factor fits (see values_).
   void release();

@@ -13,16 +13,32 @@ struct PointCondition {
   double value;  // a pressure, or an injected flux (volume per time, positive into the pore)
 };
 
+// A pressure that varies along one axis over one pressure wall (YADE's boundaryXPos and
+// boundaryPressure, on ymax along x): each Dirichlet cell of the wall takes the pressure
+// interpolated linearly at its power centre; cells beyond the first or last point keep the
+// wall's value. Empty: the wall's value everywhere.
+struct PressureProfile {
+  int wall = 3;
+  int axis = 0;
+  std::vector<double> position, pressure;  // positions increasing
+  bool empty() const { return position.empty(); }
+  bool operator==(const PressureProfile&) const = default;
+};
+
 struct BoundaryConditions {
   std::array<bool, kWallCount> is_pressure{};  // else no-flux
   std::array<double, kWallCount> value{};
   std::vector<PointCondition> imposed_pressure;
   std::vector<PointCondition> imposed_flux;
+  PressureProfile profile;
 };
 
+// The profile's pressure at x, or 'outside' beyond its points (or without a profile).
+double profile_pressure(const PressureProfile& profile, double x, double outside);
+
 // Throws std::invalid_argument naming the first non-finite boundary value, imposed point or
-// imposed value. Whether an imposed point lies in the pore space is known only on a mesh
-// (build_linear_system checks it there).
+// imposed value, or a profile that is not two or more finite points at increasing positions. Whether an imposed point
+// lies in the pore space is known only on a mesh (build_linear_system checks it there).
 void validate(const BoundaryConditions& bc);
 
 }  // namespace pfv

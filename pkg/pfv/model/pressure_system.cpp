@@ -9,19 +9,27 @@ namespace pfv {
 
 PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets, const std::vector<double>& k,
                                         const BoundaryConditions& bc, const std::vector<int>& imposed_cells,
-                                        const std::vector<double>& storage) {
+                                        const std::vector<double>& storage, const CellConditions& cells) {
   const int nc = mesh.n_cells();
   PressureSystem s;
-  s.source.assign(nc, -1);
+  s.source.assign(nc, kUnknownCell);
   for (int c = 0; c < nc; ++c)
     for (int v : mesh.cell_vertices[c])  // later walls win, as in YADE
       if (mesh.is_wall(v) && bc.is_pressure[mesh.wall_of(v)]) s.source[c] = std::max(s.source[c], mesh.wall_of(v));
   for (std::size_t i = 0; i < imposed_cells.size(); ++i)
     if (imposed_cells[i] >= 0) s.source[imposed_cells[i]] = kWallCount + static_cast<int>(i);
+  if (!cells.pressure.empty())
+    for (int c = 0; c < nc; ++c) {
+      if (cells.pressure[c] == CellPressure::kImposed) s.source[c] = kCellImposedSource;
+      if (cells.pressure[c] == CellPressure::kFree) s.source[c] = kUnknownCell;
+    }
+  if (!cells.blocked.empty())
+    for (int c = 0; c < nc; ++c)
+      if (cells.blocked[c]) s.source[c] = kBlockedCell;
 
   s.unknown.assign(nc, -1);
   for (int c = 0; c < nc; ++c)
-    if (s.source[c] < 0) {
+    if (s.source[c] == kUnknownCell) {
       s.unknown[c] = static_cast<int>(s.unknown_cell.size());
       s.unknown_cell.push_back(c);
     }
@@ -41,12 +49,13 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
   for (int f = 0; f < facets.size(); ++f) {
     const int a = facets.cell[f][0], b = facets.cell[f][1];
     if (b < 0) continue;
+    const double kf = s.source[a] == kBlockedCell || s.source[b] == kBlockedCell ? 0.0 : k[f];
     s.adj_cell[fill[a]] = b;
-    s.adj_k[fill[a]++] = k[f];
+    s.adj_k[fill[a]++] = kf;
     s.adj_cell[fill[b]] = a;
-    s.adj_k[fill[b]++] = k[f];
-    s.diagonal[a] += k[f];
-    s.diagonal[b] += k[f];
+    s.adj_k[fill[b]++] = kf;
+    s.diagonal[a] += kf;
+    s.diagonal[b] += kf;
   }
 
   if (!storage.empty())
@@ -72,7 +81,8 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
   }
   const int isolated = static_cast<int>(std::count(reached.begin(), reached.end(), 0));
   if (isolated > 0) {
-    const bool none = std::none_of(s.source.begin(), s.source.end(), [](int x) { return x >= 0; });
+    const bool none =
+        std::none_of(s.source.begin(), s.source.end(), [](int x) { return x >= 0 || x == kCellImposedSource; });
     throw std::domain_error(none ? "singular pressure system: no boundary has an imposed pressure (set "
                                    "bndCondIsPressure on at least one wall, or imposePressure somewhere)"
                                  : "singular pressure system: " + std::to_string(isolated) +

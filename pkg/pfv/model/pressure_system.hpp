@@ -1,24 +1,32 @@
 // The linear system G p = -dV/dt + Q_q + Q_p over the pore cells (thesis 3.5).
 //
 // Cells touching a pressure wall, or holding an imposed pressure, are Dirichlet cells and
-// drop out of the unknowns; their pressures enter the right-hand side. G is symmetric
-// positive definite once every group of connected unknown cells reaches a Dirichlet cell;
-// assembly checks this and names the problem otherwise.
+// drop out of the unknowns; their pressures enter the right-hand side. Conditions set on single
+// cells (cell_conditions.hpp) impose or free a cell's pressure, or block the cell: a blocked
+// cell is no unknown and its throats carry no flux. G is symmetric positive definite once every
+// group of connected unknown cells reaches a Dirichlet cell; assembly checks this and names the
+// problem otherwise.
 #pragma once
 #include <vector>
 
 #include "pfv/model/boundary_conditions.hpp"
+#include "pfv/model/cell_conditions.hpp"
 #include "triangulation/mesh.hpp"
 #include "triangulation/pore_geometry.hpp"
 
 namespace pfv {
 
+// PressureSystem::source of a cell that is no Dirichlet cell of a wall or an imposed point.
+constexpr int kUnknownCell = -1;        // an unknown
+constexpr int kCellImposedSource = -2;  // imposed on the cell itself: its pressure is kept
+constexpr int kBlockedCell = -3;        // blocked: no unknown, no flux through its throats
+
 struct PressureSystem {
   // Per cell.
-  std::vector<int> unknown;      // index among unknowns, -1 for a Dirichlet cell
-  std::vector<int> source;       // Dirichlet source: wall w, or kWallCount + imposed point; else -1
+  std::vector<int> unknown;      // index among unknowns, -1 for any other cell
+  std::vector<int> source;       // Dirichlet source: wall w, or kWallCount + imposed point; else one of the above
   std::vector<double> diagonal;  // sum of k over the cell's throats
-  // Cell adjacency through throats, both directions (CSR).
+  // Cell adjacency through throats, both directions (CSR); k is 0 through a blocked cell's throats.
   std::vector<int> adj_start, adj_cell;
   std::vector<double> adj_k;
   // Unknowns.
@@ -41,15 +49,17 @@ struct PressureSystem {
 
 // imposed_cells[k] is the cell of bc.imposed_pressure[k] (-1 if it lies in no cell).
 // storage (optional, per cell) adds V_i / (K dt) to the diagonal: fluid compressibility.
+// cells (optional): the conditions set on single cells, which override the boundaries.
 PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets, const std::vector<double>& k,
                                         const BoundaryConditions& bc, const std::vector<int>& imposed_cells,
-                                        const std::vector<double>& storage = {});
+                                        const std::vector<double>& storage = {}, const CellConditions& cells = {});
 
 // Fills row_width, row_column, row_value and row_diagonal from col_start, row and value
 // (build_linear_system does it for a 32-bit factor, whose refinement reads them).
 void index_rows(PressureSystem& s);
 
-// Pressures of the Dirichlet cells from the current boundary values (cheap; every step).
+// Pressures of the Dirichlet cells of walls and imposed points from the current boundary values
+// (cheap; every step). Cells imposed on themselves and blocked cells keep their pressures.
 void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc, std::vector<double>& pressure);
 
 }  // namespace pfv

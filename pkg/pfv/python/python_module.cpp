@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <tuple>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -220,6 +221,19 @@ PYBIND11_MODULE(_core, m) {
            exclusive([](const SharedEngine& e) { return e.cholesky() ? e.cholmod().factor_flops() : 0.0; }))
       .def_property("fluid_bulk_modulus", get_setting(&EngineSettings::fluid_bulk_modulus),
                     set_setting(&EngineSettings::fluid_bulk_modulus))
+      .def_property("minimum_porosity", get_setting(&EngineSettings::minimum_porosity),
+                    set_setting(&EngineSettings::minimum_porosity),
+                    "A compressible cell stores at least minimum_porosity times its volume (YADE's minimumPorosity).")
+      .def_property("volume_correction", get_setting(&EngineSettings::volume_correction),
+                    set_setting(&EngineSettings::volume_correction),
+                    "dV/dt of the cells without wall vertices is multiplied by this (YADE's volumeCorrection).")
+      .def_property("flat_threshold", get_setting(&EngineSettings::flat_threshold),
+                    set_setting(&EngineSettings::flat_threshold),
+                    "Cells of at most this volume are blocked at each remesh (YADE's flatThreshold; < 0: none).")
+      .def_property("interpolate_on_remesh", get_setting(&EngineSettings::interpolate_on_remesh),
+                    set_setting(&EngineSettings::interpolate_on_remesh),
+                    "Carry pressures and blocked cells over at a remesh for a direct incompressible solve too "
+                    "(YADE's doInterpolate).")
       .def_property("background_remesh", get_setting(&EngineSettings::background_remesh),
                     set_setting(&EngineSettings::background_remesh))
       .def_property("viscous_shear", get_setting(&EngineSettings::viscous_shear),
@@ -257,6 +271,19 @@ PYBIND11_MODULE(_core, m) {
                       validate(bc);
                       e.bc = bc;
                     }))
+      .def_property(
+          "pressure_profile", exclusive([](const SharedEngine& e) {
+            const PressureProfile& p = e.bc.profile;
+            return py::make_tuple(p.wall, p.axis, p.position, p.pressure);
+          }),
+          exclusive([](SharedEngine& e, const std::tuple<int, int, std::vector<double>, std::vector<double>>& v) {
+            BoundaryConditions bc = e.bc;
+            bc.profile = {std::get<0>(v), std::get<1>(v), std::get<2>(v), std::get<3>(v)};
+            validate(bc);
+            e.bc = bc;
+          }),
+          "(wall, axis, positions, pressures): the pressure along an axis of a pressure wall "
+          "(boundary_conditions.hpp).")
       .def("impose_pressure", exclusive([](SharedEngine& e, const std::array<double, 3>& x, double p) {
              return add_point_condition(e, e.bc.imposed_pressure, {Vec3(x[0], x[1], x[2]), p});
            }))
@@ -272,6 +299,16 @@ PYBIND11_MODULE(_core, m) {
            }))
       .def("clear_imposed_flux", exclusive([](SharedEngine& e) { e.bc.imposed_flux.clear(); }))
       .def("request_remesh", exclusive(&FlowEngine::request_remesh))
+      .def("remesh",
+           exclusive([](SharedEngine& e, const Array& centres, const Array& radii, const std::array<double, 6>& walls) {
+             auto c = to_points(centres, "positions");
+             auto r = to_vector(radii, "radii");
+             const BoxWalls w = to_walls(walls);
+             py::gil_scoped_release release;
+             e.remesh(c, r, w);
+           }),
+           py::arg("positions"), py::arg("radii"), py::arg("walls"),
+           "Remesh now without a linear system: the next step builds it (for conditions set on the new cells).")
       .def("request_system_rebuild", exclusive(&FlowEngine::request_system_rebuild))
       .def("reset_history", exclusive(&FlowEngine::reset_history))
       .def("release", exclusive(&FlowEngine::release),
@@ -398,4 +435,5 @@ PYBIND11_MODULE(_core, m) {
   bind_geometry(engine);
   bind_persistence(engine);
   bind_output(engine);
+  bind_cells(engine);
 }

@@ -116,5 +116,6 @@ using EngineClass = py::class_<SharedEngine>;
 void bind_geometry(EngineClass& engine);     // geometry_bindings.cpp
 void bind_output(EngineClass& engine);       // output_bindings.cpp
 void bind_persistence(EngineClass& engine);  // persistence_bindings.cpp
+void bind_cells(EngineClass& engine);        // cell_bindings.cpp
 
 }  // namespace pfv::python

@@ -36,6 +36,11 @@ CORE_NAME: dict[str, str] = {
     "pZero": "p_zero",
     "multithread": "background_remesh",
     "fluidBulkModulus": "fluid_bulk_modulus",
+    "minimumPorosity": "minimum_porosity",
+    "flatThreshold": "flat_threshold",
+    "volumeCorrection": "volume_correction",
+    "doInterpolate": "interpolate_on_remesh",
+    "meanK_opt": "clamp_k_values",  # YADE's deprecated alias of clampKValues
     "viscousShear": "viscous_shear",
     # PFV extensions (PEP 8 names: YADE has no equivalent).
     "mixed_precision": "mixed_precision",

@@ -47,11 +47,14 @@ class SceneScan:
     `wall_ids` and `use_max_min` are the engine's wallIds and boundaryUseMaxMin; `use_sphere_pack`
     False always reads the coordinate lists; `warned` collects the one-time warnings of the engine;
     `previous` is the last scan, whose force bridge and position array are reused when they fit.
+    YADE's `mask` (> 0: only spheres whose groupMask shares a bit with it), `convert_clumps` (False:
+    clump members are coupled as spheres, the clumps left out) and `wall_thickness` (> 0: a wall
+    body bounds the domain at this half thickness from its centre) are applied as YADE does.
     """
 
     def __init__(self, wall_ids: Sequence[int], use_max_min: Sequence[bool], *, use_sphere_pack: bool = True,
-                 convert_clumps: bool = True, warned: set[str] | None = None,
-                 previous: SceneScan | None = None) -> None:
+                 warned: set[str] | None = None, previous: SceneScan | None = None, mask: int = 0,
+                 convert_clumps: bool = True, wall_thickness: float = 0.0) -> None:
         scene = yade.O
         if scene.periodic:
             raise NotImplementedError("pfv.FlowEngine does not support periodic scenes yet")
@@ -73,6 +76,8 @@ class SceneScan:
             pack_size += is_sphere
             if bid in wall_set:
                 continue
+            if mask > 0 and not b.groupMask & mask:
+                continue  # not affected by this engine (YADE leaves it out of the triangulation)
             if is_clump:
                 if not convert_clumps:
                     continue  # its members are the spheres
@@ -123,8 +128,11 @@ class SceneScan:
                 raise ValueError(f"wallIds[{w}] = {bid} names a {type(b.shape).__name__} body, not a wall "
                                  "(a Box, Wall or Facet)")
             wall_rows.append(row_of[bid])
-            # A box wall bounds the domain with its inner face.
-            half = b.shape.extents[w // 2] if isinstance(b.shape, Box) else 0.0
+            # A box wall bounds the domain with its inner face, unless wallThickness says where.
+            if wall_thickness > 0:
+                half = 0.5 * wall_thickness
+            else:
+                half = b.shape.extents[w // 2] if isinstance(b.shape, Box) else 0.0
             wall_half.append(-half if w % 2 else half)
         vertex_of_id = {bid: k for k, bid in enumerate(ids)}
         for w, bid in enumerate(self.wall_ids):

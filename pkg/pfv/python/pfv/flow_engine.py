@@ -9,14 +9,13 @@ An attribute YADE's FlowEngine has but PFV does not support may only be set to Y
 default value; any other value raises NotImplementedError naming it. Misspelt names raise
 AttributeError. Nothing is silently ignored.
 
-This module holds the engine class, which composes three parts: the attribute surface
-(``_attributes``), the scan of YADE's bodies (``_scene_scan.SceneScan``) and the time-step
-guard (``_time_step.TimeStepGuard``).
+This module holds the engine class, which composes four parts: the attribute surface
+(``_attributes``), the scan of YADE's bodies (``_scene_scan.SceneScan``), the time-step
+guard (``_time_step.TimeStepGuard``) and the members on single cells (``_cell_interface``, a mixin).
 """
 from __future__ import annotations
 
 import contextlib
-import functools
 import numbers
 import os
 import re
@@ -35,6 +34,8 @@ from yade.minieigenHP import Vector3
 
 from . import _attributes as attributes
 from . import _persistence
+from ._locking import exclusive as _exclusive
+from ._cell_interface import CELL_INTERNAL, CellInterface
 from ._core import Engine, set_num_threads
 from ._scene_scan import SceneScan
 from ._timing import StageTimings, StepClock
@@ -67,6 +68,11 @@ def _run(key: int) -> None:
                 "scene carries no saved state for it (saved before PFV could add it?); create a new "
                 "pfv.FlowEngine and put it back into O.engines")
     engine._step()
+
+
+def _as_tuples(value: Any) -> Any:
+    """JSON gives lists where the engine keeps tuples."""
+    return tuple(_as_tuples(v) for v in value) if isinstance(value, list) else value
 
 
 def _gravity(scene: Any) -> tuple[float, float, float]:
@@ -107,7 +113,7 @@ _INTERNAL = frozenset({
     "_scan",                  # the last SceneScan, None before the first step
     "_stepped",               # the SceneScan of the last successful step: the current mesh's spheres
     "_scene_tag",             # the value this engine left in O.tags: a new scene lacks it
-    "_last_step",             # (O.iter, O.time) of the last successful step, None: no history
+    "_last_step",             # (O.iter, O.time, dt) of the last successful step, None: no history
     "_guard",                 # the TimeStepGuard
     "_timings",               # the StageTimings shown by timing.stats()
     "_boundary_use_max_min",  # boundaryUseMaxMin
@@ -115,18 +121,7 @@ _INTERNAL = frozenset({
     "_warned",                # the one-time warnings given
     "_threads",               # ompThreads, None: follow YADE's -j
     "_use_sphere_pack",       # False: always read the coordinate lists
-    "_convert_clumps",        # convertClumps
-})
-
-
-def _exclusive(method):
-    """Run `method` under the engine's lock: a query made while YADE's simulation thread is inside
-    a step waits for that step, and never sees a mesh being rebuilt."""
-    @functools.wraps(method)
-    def locked(self, *args, **kwargs):
-        with self._lock:
-            return method(self, *args, **kwargs)
-    return locked
+}) | CELL_INTERNAL
 
 
 def _guard_setting(name: str, doc: str) -> property:
@@ -135,7 +130,7 @@ def _guard_setting(name: str, doc: str) -> property:
                     doc=doc)
 
 
-class FlowEngine(PyRunner):
+class FlowEngine(CellInterface, PyRunner):
     """PFV's DEM-PFV flow engine with the interface of YADE's FlowEngine."""
 
     xmin, xmax, ymin, ymax, zmin, zmax = range(6)
@@ -154,7 +149,6 @@ class FlowEngine(PyRunner):
         self._warned = set()
         self._scan = None
         self._use_sphere_pack = True
-        self._convert_clumps = True
         self._threads = None
         self._guard = TimeStepGuard()
         _engines[self._key] = self
@@ -232,22 +226,6 @@ class FlowEngine(PyRunner):
             self._core.reset_history()
 
     @property
-    def convertClumps(self) -> bool:
-        """True (YADE's default): a clump enters the triangulation as the sphere of its volume at its
-        centre of mass, and its fluid force goes to the clump; False: its spherical members are
-        triangulated as spheres of their own (YADE's Newton integrator sums their forces)."""
-        return self._convert_clumps
-
-    @convertClumps.setter
-    def convertClumps(self, value: bool) -> None:
-        value = attributes.as_setting("convertClumps", value, True)
-        if value != self._convert_clumps:
-            with self._lock:
-                self._convert_clumps = value
-                if self._scan is not None:
-                    self._scan.outdated = True
-
-    @property
     def useSolver(self) -> int:
         """YADE's solver number: 0 Gauss-Seidel, 1 conjugate gradients (PFV), 3 CHOLMOD."""
         return attributes.use_solver_of(self._core.solver)
@@ -291,9 +269,9 @@ class FlowEngine(PyRunner):
     # -- the step ---------------------------------------------------------------------------
     def _rescan(self) -> SceneScan:
         """Scan the bodies again (sphere ids, radii, masses, walls); done at each remesh (bodies may change)."""
+        self._apply_id_offset()
         self._scan = SceneScan(self._wall_ids, self._boundary_use_max_min, use_sphere_pack=self._use_sphere_pack,
-                               convert_clumps=self._convert_clumps,
-                               warned=self._warned, previous=self._scan)
+                               warned=self._warned, previous=self._scan, **self._scan_options())
         return self._scan
 
     def _scanned(self) -> SceneScan:
@@ -358,6 +336,8 @@ class FlowEngine(PyRunner):
 
     @_exclusive
     def _step(self) -> None:
+        if not self._pressure_force:  # YADE's pressureForce=False: no flow at all
+            return
         scene = yade.O
         core = self._core
         clock = StepClock(self._timings) if scene.timingEnabled else None
@@ -386,14 +366,19 @@ class FlowEngine(PyRunner):
         self._check_time_step(scene.dt, scan, collective=self._guard.known_limit(core))
         remeshing = core.remesh_due()
         inversions, meshes = core.inversion_remeshes, core.remesh_count
+        before = (core.remesh_count, core.system_builds) if self._after_step_reports else None
+        if self._desired_porosity:
+            self._correct_volumes(pos, scan.radii)
         if clock:
             clock.lap("time-step guard")
         with self._bodies_named(scan):
+            if self._block_hook and remeshing and not core.background_remesh:
+                self._remesh_for_block_hook(pos, scan, walls)  # blockHook, between the mesh and its system
             core.step(pos, scan.radii, walls, dt)
         if clock:
             clock.core_step(core, core.remesh_count != meshes)
         self._stepped = scan
-        self._last_step = (scene.iter, scene.time)
+        self._last_step = (scene.iter, scene.time, dt)  # dt: the time this step's dV/dt spanned
         _holding.add(self._key)
         _release_unused(self)
         if self._guard.stale(core):
@@ -420,8 +405,11 @@ class FlowEngine(PyRunner):
                               stacklevel=2)
         if clock:
             clock.lap("time-step guard and warnings")
+        if self._after_step_reports:
+            self._report_step(before)
         # The engine's force array is read in C++, without a numpy copy.
-        scan.force_bridge.apply(scene.forces.addF, core)
+        if not self._decouple_forces:
+            scan.force_bridge.apply(scene.forces.addF, core)
         if clock:
             clock.lap("forces to YADE")
 
@@ -645,7 +633,7 @@ class FlowEngine(PyRunner):
             "wall_ids": list(self._wall_ids),
             "threads": self._threads,
             "use_sphere_pack": self._use_sphere_pack,
-            "convert_clumps": self._convert_clumps,
+            "mixin": {name: getattr(self, name) for name in sorted(CELL_INTERNAL - {"_power_volumes"})},
             "guard": {name: getattr(self._guard, name) for name in _SAVED_GUARD_SETTINGS},
             "runner": {name: getattr(self, name) for name in ("iterPeriod", "dead", "initRun")},
             "last_step": list(self._last_step) if running and self._last_step else None,
@@ -669,7 +657,8 @@ class FlowEngine(PyRunner):
         engine._wall_ids = list(state["wall_ids"])
         engine._threads = state["threads"]
         engine._use_sphere_pack = state["use_sphere_pack"]
-        engine._convert_clumps = state.get("convert_clumps", True)
+        for name, value in state["mixin"].items():
+            setattr(engine, name, _as_tuples(value))
         for name, value in state["guard"].items():
             setattr(engine._guard, name, value)
         for name, value in state["runner"].items():
@@ -714,8 +703,9 @@ class FlowEngine(PyRunner):
         return self._core
 
 
-# Names set as ordinary attributes: PyRunner's (command, iterPeriod, label, ...) and FlowEngine's properties.
+# Names set as ordinary attributes: PyRunner's (command, iterPeriod, label, ...) and the properties
+# of FlowEngine and its mixin.
 _OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
-    name for name, v in vars(FlowEngine).items() if isinstance(v, property)}
+    name for klass in FlowEngine.__mro__ for name, v in vars(klass).items() if isinstance(v, property)}
 
 _persistence.install()  # O.save / O.load carry the engines' state

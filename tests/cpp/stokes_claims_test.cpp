@@ -112,7 +112,9 @@ TEST(StokesClaims, YadeWallThroatFactorScalesOnlyWallThroats) {
     for (int v : plain.facets().vertex[f]) walls += plain.mesh().is_wall(v) ? 1 : 0;
     const double k0 = plain.conductances()[f], k1 = yade.conductances()[f];
     const double expected = walls == 0 ? 1.0 : walls == 1 ? std::sqrt(0.5) : 0.5;  // (R_h factor)^2
-    if (k0 > 0) EXPECT_NEAR(k1 / k0, expected, 1e-12) << "facet " << f << ", " << walls << " wall vertices";
+    if (k0 > 0) {
+      EXPECT_NEAR(k1 / k0, expected, 1e-12) << "facet " << f << ", " << walls << " wall vertices";
+    }
     one += walls == 1 && k0 > 0;
     two += walls == 2 && k0 > 0;
   }

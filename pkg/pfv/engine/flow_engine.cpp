@@ -52,6 +52,8 @@ FlowEngine::RunState FlowEngine::run_state() const {
     s.previous_walls = walls_prev_;
   }
   s.pressure = pressure_;
+  s.cells = cells_;
+  s.void_volume = measured_void_volume_;
   s.steps_since_remesh = steps_since_remesh_;
   s.strain = strain_;
   return s;
@@ -74,11 +76,21 @@ void FlowEngine::resume(const RunState& s, double dt) {
       throw std::invalid_argument("the saved pressures (" + std::to_string(s.pressure.size()) +
                                   " cells) do not fit the rebuilt mesh (" + std::to_string(pressure_.size()) +
                                   " cells)");
+    const auto fits = [&](std::size_t n) { return n == 0 || n == pressure_.size(); };
+    if (!fits(s.cells.pressure.size()) || !fits(s.cells.blocked.size()) || !fits(s.void_volume.size()))
+      throw std::invalid_argument("the saved cell conditions or void volumes do not fit the rebuilt mesh (" +
+                                  std::to_string(pressure_.size()) + " cells)");
   } catch (...) {
     release();
     throw;
   }
   pressure_ = s.pressure;
+  if (!s.cells.empty() || !s.void_volume.empty()) {
+    // Flat cells are found again by the rebuild; the saved conditions hold them and the rest.
+    cells_ = s.cells;
+    measured_void_volume_ = s.void_volume;
+    system_rebuild_requested_ = true;
+  }
   steps_since_remesh_ = s.steps_since_remesh;
   strain_ = s.strain;
 }
@@ -185,45 +197,46 @@ void FlowEngine::remesh_in_background(const std::vector<Vec3>& centres, const st
   steps_since_remesh_ = 0;
 }
 
-void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
-                            double dt) {
+FlowEngine::Remesh FlowEngine::mesh_without_system(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                                                   const BoxWalls& walls) {
   if (pending_) {  // superseded by this one
     pending_->result.wait();
     pending_.reset();
   }
-  PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
-  CellConditions conditions = flat_cells(m, settings);
-  carry_blocked_cells(m, conditions, centres, walls);
+  Remesh r{build_pore_mesh(centres, radii, walls, settings), {}, {}};
+  r.cells = flat_cells(r.mesh, settings);
+  carry_blocked_cells(r.mesh, r.cells, centres, walls);
+  return r;
+}
+
+void FlowEngine::restart_schedule() {
+  strain_ = 0;
+  steps_since_remesh_ = 0;
+  remesh_requested_ = false;
+}
+
+void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
+                            double dt) {
+  Remesh r = mesh_without_system(centres, radii, walls);
   // Free the old factor first (the largest object: peak memory is then one factor, not two).
   // Should the new system fail, the old mesh is kept without a solver and the next step starts
   // the remesh over; the last results stay readable meanwhile.
   remesh_requested_ = true;
   const auto ordering = linear_.ordering;  // survives the release of the old factor
-  LinearSystem l = build_linear_system(m, bc, settings, dt, ordering.get(), released_solver(), {&conditions});
-  adopt(std::move(m), std::move(l), std::move(conditions));
-  strain_ = 0;
-  steps_since_remesh_ = 0;
-  remesh_requested_ = false;
+  r.linear = build_linear_system(r.mesh, bc, settings, dt, ordering.get(), released_solver(), {&r.cells});
+  adopt(std::move(r.mesh), std::move(r.linear), std::move(r.cells));
+  restart_schedule();
 }
 
 void FlowEngine::remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls) {
   validate(settings);
   validate(bc);
   validate_snapshot(centres, radii, walls);
-  if (pending_) {  // superseded by this one
-    pending_->result.wait();
-    pending_.reset();
-  }
-  PoreMesh m = build_pore_mesh(centres, radii, walls, settings);
-  CellConditions conditions = flat_cells(m, settings);
-  carry_blocked_cells(m, conditions, centres, walls);
+  Remesh r = mesh_without_system(centres, radii, walls);
   // No system yet: the next step builds it, with the conditions set on the new cells meanwhile.
-  LinearSystem none;
-  none.ordering = linear_.ordering;
-  adopt(std::move(m), std::move(none), std::move(conditions), false);
-  strain_ = 0;
-  steps_since_remesh_ = 0;
-  remesh_requested_ = false;
+  r.linear.ordering = linear_.ordering;
+  adopt(std::move(r.mesh), std::move(r.linear), std::move(r.cells), false);
+  restart_schedule();
 }
 
 CellConditions FlowEngine::flat_cells(const PoreMesh& m, const EngineSettings& s) {

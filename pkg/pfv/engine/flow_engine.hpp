@@ -50,13 +50,16 @@ class FlowEngine {
 
   // What a run needs to go on exactly where it stopped (a saved and reloaded simulation): the
   // positions the current mesh was built from, the positions of the last step, the pressures,
-  // and the remesh schedule. resume() rebuilds the same mesh (the triangulation is a function of
-  // its input) and restores the rest, so that the next step equals the uninterrupted run's.
+  // the conditions set on single cells, and the remesh schedule. resume() rebuilds the same mesh
+  // (the triangulation is a function of its input) and restores the rest, so that the next step
+  // equals the uninterrupted run's; the cell indices of the rebuilt mesh are those of the saved.
   struct RunState {
     MeshSource mesh;
     std::vector<Vec3> previous_centres;  // empty: no dV/dt history
     BoxWalls previous_walls;
-    std::vector<double> pressure;  // per cell of the mesh
+    std::vector<double> pressure;     // per cell of the mesh
+    CellConditions cells;             // set on single cells of the mesh (set_cell_imposed, block_cell)
+    std::vector<double> void_volume;  // measured by initialize_volumes (empty: the mesh's own)
     int steps_since_remesh = 0;
     double strain = 0;
   };
@@ -194,6 +197,11 @@ class FlowEngine {
   void remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                             double dt);
   void remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
+  // The first half of a foreground remesh: a background remesh in flight is superseded, the mesh
+  // of these positions is built, with its flat cells and the blocked cells carried over.
+  Remesh mesh_without_system(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls);
+  // The last half: the remesh schedule starts again.
+  void restart_schedule();
   // with_system: the linear system of the mesh (else an empty one, built at the next step).
   void adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system = true);
   // The conditions of a new mesh: its cells of at most settings.flat_threshold volume blocked.

@@ -162,6 +162,26 @@ def conditions_and_remesh():
     check("pressureForce=False runs no flow step", flow.core.remesh_count == remeshes)
 
 
+def velocities_follow_the_pressures():
+    """getCellVelocity is evaluated once per step for all cells (a script asks cell by cell), and
+    again after anything that changes the pressures between steps."""
+    flow = engine()
+    O.run(1, True)
+    point = (0.5, 0.5, 0.5)
+    first = flow.getCellVelocity(point)
+    check("a second query on the same step gives the same velocity", flow.getCellVelocity(point) == first)
+    c = flow.getCell(*point)
+    flow.setCellPressure(flow.getNeighbors(c)[0], 5.0)  # a neighbour's pressure drives the cell's flow
+    changed = flow.getCellVelocity(point)
+    check("setCellPressure between steps changes the velocity at once", changed != first, f"{first} -> {changed}")
+    flow.setCellPImposed(flow.getNeighbors(c)[0], True)
+    O.run(1, True)
+    stepped = flow.getCellVelocity(point)
+    check("the next step's velocity is the new pressures'", stepped != changed and stepped != first)
+    lengths = [len(flow.getCellVelocity(flow.getCellBarycenter(k))) for k in range(flow.nCells())]
+    check("every cell answers from the shared evaluation", set(lengths) == {3})
+
+
 def clumps():
     spheres = scenes.packing(1000)
     # Two touching neighbours become a clump: with convertClumps=False PFV couples them as spheres.
@@ -192,6 +212,7 @@ def main():
     bad_arguments()
     attributes_and_reports()
     conditions_and_remesh()
+    velocities_follow_the_pressures()
     clumps()
     failed = 0
     for name, ok, detail in results:

@@ -129,8 +129,8 @@ O.loadTmp("cells")
 restored = builtins.flow
 rb.check("cells imposed before the save are imposed after the load",
          all(restored.getCellPImposed(c) for c in imposed) and not restored.getCellPImposed(11))
-rb.check("the imposed cells hold their pressures", [restored.getPorePressure(restored.getCellBarycenter(c))
-                                                     for c in imposed] == [0.2 + 0.3 * k for k in range(3)])
+held = [restored.getPorePressure(restored.getCellBarycenter(c)) for c in imposed]
+rb.check("the imposed cells hold their pressures", held == [0.2 + 0.3 * k for k in range(3)], f"{held}")
 rb.check("the void volumes of initializeVolumes are carried",
          [restored.getCellInvVoidVolume(c) for c in remeasured] == inverse_volumes)
 compare("cell conditions and measured void volumes", ref, run_sampled(6, lower_top_wall))

@@ -12,8 +12,7 @@ script, this test runs the loop for --steps steps (1500: past those 1.5 s) and c
 balance both ways, that the force check ran, that water came in, and that cells filled and were
 freed.
 
-The script also calls saveVtk; while pfv.FlowEngine has no saveVtk the test gives the engine a
-stand-in that writes nothing (and says so).
+The script's saveVtk calls write into a temporary directory.
 
     yade-double -n -x tests/yade/test_yade_check_pressure_injection.py [--steps=N]   (exit 0 = pass)
 """
@@ -27,25 +26,14 @@ import __main__
 import yade
 from yade import O
 
+import pfv
+
 SCRIPT = os.path.join(yade.config.libDir, "py/yade/tests/checks/checkDEM-PFVPressureInjection.py")
 VOLUME_TOLERANCE = 1e-6  # the script's own toleranceCritical
 
 
 class YadeCheckError(Exception):
     pass
-
-
-def flow_engine_class():
-    import pfv
-    if hasattr(pfv.FlowEngine, "saveVtk"):
-        return pfv.FlowEngine
-
-    class FlowEngine(pfv.FlowEngine):
-        def saveVtk(self, folder="./VTK", withBoundaries=False):
-            pass
-
-    print("note: pfv.FlowEngine has no saveVtk yet; the script's saveVtk calls write nothing")
-    return FlowEngine
 
 
 def main(argv):
@@ -58,7 +46,7 @@ def main(argv):
         return 77
     os.chdir(tempfile.mkdtemp(prefix="pfv-injection-"))  # the script writes ./vtk and Test.txt
     ns = vars(__main__)  # its PyRunner commands are evaluated in __main__
-    ns.update(checksPath=os.path.dirname(SCRIPT), YadeCheckError=YadeCheckError, FlowEngine=flow_engine_class())
+    ns.update(checksPath=os.path.dirname(SCRIPT), YadeCheckError=YadeCheckError, FlowEngine=pfv.FlowEngine)
     from yade import plot
     plot.plot = lambda *a, **k: None  # no GUI
     source = open(SCRIPT).read()
@@ -72,7 +60,6 @@ def main(argv):
         traceback.print_exc()
         print(f"FAIL: the script raised after {time.time() - t0:.0f} s")
         return 1
-    import pfv
     engines = [e for e in O.engines if isinstance(e, pfv.FlowEngine)]
     if len(engines) != 1:
         print(f"FAIL: the script's engines hold {len(engines)} pfv.FlowEngine")

@@ -53,7 +53,11 @@ CELL_INTERNAL = frozenset({
     "_volume_factor",        # volumeFactor
     "_desired_porosity",     # desiredPorosity
     "_power_volumes",        # (mesh key, volumes) of the last compTessVolumes
+    "_cell_velocities",      # (mesh key, velocities) of the last velocity query
 })
+
+# Results kept for queries on the same mesh and step: not settings, not saved.
+CELL_CACHES = frozenset({"_power_volumes", "_cell_velocities"})
 
 # YADE's boundary normals (setBoundaryNormal), pointing into the sample.
 _NORMALS = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
@@ -122,6 +126,7 @@ class CellInterface:
     _volume_factor = 1.0
     _desired_porosity = 0.0
     _power_volumes = None
+    _cell_velocities = None
 
     # -- attributes: what a step does and reports --------------------------------------------
     iniVoidVolumes = _flag_property(
@@ -388,11 +393,20 @@ class CellInterface:
 
     def _yade_velocities(self) -> np.ndarray:
         """YADE's cell velocities: sum over the throats of q (x_throat - x_cell) / V (total volume),
-        from the core's mean fluid velocities (per fluid volume)."""
-        volume = self._core.cell_volumes()
-        fluid = self._core.cell_fluid_volumes()
-        share = np.divide(fluid, volume, out=np.zeros_like(volume), where=volume > 0)
-        return self._core.cell_velocities() * share[:, None]
+        from the core's mean fluid velocities (per fluid volume). Kept until the next step or cell
+        condition, so that a script asking cell by cell pays for one evaluation, not one per cell."""
+        key = self._mesh_key()
+        if self._cell_velocities is None or self._cell_velocities[0] != key:
+            volume = self._core.cell_volumes()
+            fluid = self._core.cell_fluid_volumes()
+            share = np.divide(fluid, volume, out=np.zeros_like(volume), where=volume > 0)
+            velocities = self._core.cell_velocities() * share[:, None]
+            velocities.flags.writeable = False  # shared by every query until the key changes
+            object.__setattr__(self, "_cell_velocities", (key, velocities))
+        return self._cell_velocities[1]
+
+    def _pressures_changed(self) -> None:
+        object.__setattr__(self, "_cell_velocities", None)
 
     def _mesh_key(self) -> tuple:
         return (self._core.remesh_count, self._last_step)
@@ -569,12 +583,14 @@ class CellInterface:
     def setCellPImposed(self, id: int, pImposed: bool) -> None:
         """Impose the cell's pressure at the value it holds (setCellPressure), or free it (an unknown even
         where a boundary would impose it). Until the next remesh; rebuilds the linear system at the next step."""
+        self._pressures_changed()
         self._core.set_cell_imposed(self._cell(id), _flag("pImposed", pImposed))
 
     @exclusive
     def setCellPressure(self, id: int, pressure: float) -> None:
         """Set the pressure the cell holds: what an imposed cell keeps (a pressure wall or imposed point applies
         its own value at the next step; the next solve overwrites an unknown)."""
+        self._pressures_changed()
         self._core.set_cell_pressure(self._cell(id), attributes.as_number("setCellPressure pressure", pressure))
 
     @exclusive
@@ -582,6 +598,7 @@ class CellInterface:
         """Cut the cell out of the flow problem until the next remesh: no flux through its throats, its
         pressure kept as it is, or set to 0 (and reported imposed) with blockPressure. Rebuilds the linear
         system at the next step (YADE: at the next remesh, or at once from blockHook)."""
+        self._pressures_changed()
         self._core.block_cell(self._cell(id), _flag("blockPressure", blockPressure))
 
     @exclusive

@@ -35,7 +35,7 @@ from yade.minieigenHP import Vector3
 from . import _attributes as attributes
 from . import _persistence
 from ._locking import exclusive as _exclusive
-from ._cell_interface import CELL_INTERNAL, CellInterface
+from ._cell_interface import CELL_CACHES, CELL_INTERNAL, CellInterface
 from ._core import Engine, set_num_threads
 from ._scene_scan import SceneScan
 from ._timing import StageTimings, StepClock
@@ -633,7 +633,7 @@ class FlowEngine(CellInterface, PyRunner):
             "wall_ids": list(self._wall_ids),
             "threads": self._threads,
             "use_sphere_pack": self._use_sphere_pack,
-            "mixin": {name: getattr(self, name) for name in sorted(CELL_INTERNAL - {"_power_volumes"})},
+            "mixin": {name: getattr(self, name) for name in sorted(CELL_INTERNAL - CELL_CACHES)},
             "guard": {name: getattr(self._guard, name) for name in _SAVED_GUARD_SETTINGS},
             "runner": {name: getattr(self, name) for name in ("iterPeriod", "dead", "initRun")},
             "last_step": list(self._last_step) if running and self._last_step else None,

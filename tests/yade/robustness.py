@@ -3,7 +3,6 @@
 Import from a script run by yade-double (the script's directory is put on sys.path first).
 """
 import math
-import os
 import sys
 
 import scenes
@@ -81,6 +80,3 @@ def report(name):
         sys.exit(1)
     print(f"all {name} checks passed")
     sys.exit(0)
-
-
-DATA_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data")

@@ -9,7 +9,6 @@ an erased sphere followed by a viscosity change. The settings are those of
 tests/data/settings_invalidation.csv, each with the value given there.
 """
 import ast
-import csv
 import math
 import os
 import sys
@@ -17,27 +16,18 @@ import warnings
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
 import robustness as rb  # noqa: E402
+import settings_table  # noqa: E402
 from yade import O, utils  # noqa: E402
 
 warnings.simplefilter("ignore")  # time-step and hidden-sphere warnings are not what is tested here
 
 
 def settings():
-    with open(os.path.join(rb.DATA_DIR, "settings_invalidation.csv")) as f:
-        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
-    for row in rows:
+    for row in settings_table.rows():
         if row["yade"] == "-":
             continue
         text = row["value"] if row["yade_value"] == "=" else row["yade_value"]
         yield row["yade"], ast.literal_eval(text)
-
-
-def apply_setting(flow, name, value):
-    member = getattr(flow, name)
-    if callable(member):
-        member(*value)
-    else:
-        setattr(flow, name, value)
 
 
 def erase_sphere(flow):
@@ -81,7 +71,7 @@ for change in SCENE_CHANGES:
         try:
             rb.run(2)
             change(flow)
-            apply_setting(flow, name, value)
+            settings_table.change(flow, name, value)
             rb.run(3)
             # The iterative solvers stop at a residual of 1e-6 relative to the right-hand side,
             # whose couplings to the pressure walls exceed the net flux by orders of magnitude.

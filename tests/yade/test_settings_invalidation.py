@@ -6,31 +6,16 @@ the C++ API. The core decides; neither Python layer requests a rebuild of its ow
     yade-double -n -x tests/yade/test_settings_invalidation.py      (exit 0 = pass)
 """
 import ast
-import csv
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
 import numpy as np  # noqa: E402
 import scenes  # noqa: E402
+from settings_table import change, rows as read_table  # noqa: E402
 from yade import O  # noqa: E402
 import pfv  # noqa: E402
 from pfv._core import Engine  # noqa: E402
-
-TABLE = os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "..", "data", "settings_invalidation.csv")
-
-
-def read_table():
-    with open(TABLE) as f:
-        return list(csv.DictReader(line for line in f if not line.startswith("#")))
-
-
-def change(target, name, value):
-    member = getattr(target, name)
-    if callable(member):
-        member(*value)
-    else:
-        setattr(target, name, value)
 
 
 def rebuilt(core, before):

@@ -3,6 +3,7 @@
 #include <numeric>
 
 #include "pfv/common/parallel.hpp"
+#include "pfv/model/force_terms.hpp"
 
 namespace pfv {
 
@@ -13,21 +14,11 @@ void ForceCache::build(const Mesh& mesh, const FacetGeometry& facets, const Pack
   for (int c = 0; c < nc; ++c) per_cell[c] = wall_footprints(mesh, c, packing);
 
   for (int f = 0; f < facets.size(); ++f) {
-    const Vec3& S = facets.area_vector[f];
-    const double area = S.norm();
-    if (area <= 0) continue;
-    const Vec3 n = S / area;
-    const auto& wet = facets.wetted_area[f];
-    const auto& sector = facets.sector_area[f];
-    const double wet_sum = wet[0] + wet[1] + wet[2];
-    int spheres = 0;
-    for (int v : facets.vertex[f]) spheres += mesh.is_wall(v) ? 0 : 1;
+    const auto terms = facet_force_terms(mesh, facets, f);
+    if (!terms) continue;
+    const Vec3& n = terms->normal;
     std::array<double, 3> coef;
-    for (int s = 0; s < 3; ++s) {
-      // Viscous share by wetted area; if no wetted area is known, equal shares to spheres.
-      const double share = wet_sum > 0 ? wet[s] / wet_sum : (mesh.is_wall(facets.vertex[f][s]) ? 0.0 : 1.0 / spheres);
-      coef[s] = sector[s] + facets.fluid_area[f] * share;
-    }
+    for (int s = 0; s < 3; ++s) coef[s] = terms->pressure[s] + terms->viscous[s];
     for (int side = 0; side < 2; ++side) {
       const int c = facets.cell[f][side];
       if (c < 0) continue;

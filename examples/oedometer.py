@@ -24,7 +24,9 @@ Thesis section 4.4 (Terzaghi consolidation of an oedometer sample). The script
    The fluid forces act on the wall bodies too, so the bottom wall reads the total stress (effective + pore);
 4. compares with Terzaghi's series solution using the measured C_v = K E_oed / gamma_w:
    U(T_v) (settlement / dry settlement under the same increment) and isochrones p(z, T_v), and prints the error
-   figures: max |U_sim - U_theory| and the RMS isochrone pressure error normalised by the load.
+   figures: max |U_sim - U_theory| and the RMS isochrone pressure error normalised by the load. With each
+   isochrone it records the increment of the effective stress sigma'_yy in the same slices (YADE's per-particle
+   stresses, thesis 2.18): pore pressure plus that increment is the load along the height (claim 18).
 
 With --nonlinear the load is 200 kPa (thesis 4.4.2): the dry secant modulus under that load and the conductivity
 measured again at the end give C_v,final, and U(T_v) is compared with both the initial and the final C_v.
@@ -98,6 +100,7 @@ from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat
                           Sphere)
 from yade import pack  # noqa: E402
 import numpy as np  # noqa: E402
+from pfv import diagnostics  # noqa: E402
 
 XMIN, XMAX, YMIN, YMAX, ZMIN, ZMAX = range(6)  # aabbWalls order = FlowEngine.wallIds order
 BOTTOM, TOP = YMIN, YMAX                        # the vertical axis is y (as in YADE's example)
@@ -477,6 +480,15 @@ def slice_pressure(flow, y, n):
     return s / (n * n)
 
 
+def effective_stress(n):
+    """sigma'_yy in n equal horizontal slices between the walls (YADE's per-particle stresses, thesis 2.18;
+    compression positive), from the bottom up; the same for both engines."""
+    ids, pos, rad, _, _ = diagnostics.sphere_arrays(O.bodies)
+    bottom = wall_y(BOTTOM)
+    return diagnostics.effective_stress_profile(utils.bodyStressTensors(), ids, pos, rad, bottom, bottom + height(),
+                                                n, area())[1]
+
+
 def permeameter(flow, P, triax):
     """Steady permeameter: dp on the bottom, 0 on the top, everything held still: K = Q gamma_w H / (A dp).
 
@@ -554,6 +566,7 @@ def run(opts):
     flow.bndCondValue = [0.0] * 6
     flow.updateTriangulation = True  # YADE applies new boundary types at a remesh
     sigma_start = top_stress()
+    sigma_eff_start = effective_stress(P['profile_points'])  # the load adds to this, slice by slice
     triax.goal2 = -(P['sigma0'] + P['load'])
     triax.max_vel = P['wall_speed'] * dry_eps * H0 / t_c  # do not let the wall speed limit the settlement
     it0, t0 = O.iter, O.time
@@ -604,11 +617,14 @@ def run(opts):
                          p_mid_theory=row['p_mid_theory'] / P['load'])
         if iso_left and row['Tv'] >= iso_left[0] * (1 - 1e-9):
             T_iso = iso_left.pop(0)
+            d_sigma = (effective_stress(P['profile_points']) - sigma_eff_start) / P['load']
             for i in range(P['profile_points']):
                 rel = (i + 0.5) / P['profile_points']  # height above the bottom / H
                 p = slice_pressure(flow, wall_y(BOTTOM) + rel * H, n)
                 iso.append(dict(Tv_target=T_iso, Tv=row['Tv'], z_over_H=rel, p_over_load=p / P['load'],
-                                p_theory_over_load=plain.p(rel, t), p_theory_layer_over_load=layer.p(rel, t)))
+                                p_theory_over_load=plain.p(rel, t), p_theory_layer_over_load=layer.p(rel, t),
+                                d_sigma_eff_over_load=d_sigma[i],
+                                p_plus_d_sigma_eff_over_load=p / P['load'] + d_sigma[i]))
         if len(rows) % 10 == 0 or T == targets[-1]:
             log('T_v %.4f  U_sim %.4f  U_th %.4f  p_mid/load %.4f (th %.4f)  bottom total stress %.5g Pa'
                 % (row['Tv'], row['U_sim'], row['U_theory'], p_mid / P['load'], row['p_mid_theory'] / P['load'],
@@ -641,6 +657,9 @@ def run(opts):
                    U_max_abs_error_all=max(abs(r['U_sim'] - r['U_theory']) for r in rows),
                    isochrone_rms_error_all=rms(r['p_over_load'] - r['p_theory_over_load'] for r in iso),
                    max_p_mid_over_load=max(r['p_mid'] for r in rows) / P['load'],
+                   # claim 18: pore pressure + effective stress increment = the load increment along the height
+                   p_plus_sigma_eff_max_error_Tv01=max((abs(r['p_plus_d_sigma_eff_over_load'] - 1) for r in iso
+                                                        if r['Tv_target'] == 0.1), default=float('nan')),
                    bottom_total_stress_max_error=max(abs(r['sigma_bottom_total'] - load_total)
                                                      for r in win) / P['load'],
                    drained_over_settlement_volume_end=rows[-1]['drained_volume'] / rows[-1]['settlement_volume'],

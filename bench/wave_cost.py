@@ -8,7 +8,9 @@ ForceResetter, pfv.FlowEngine, NewtonIntegrator. After a first step (the mesh an
 `steps` steps with the load pfv.waves.StandingWave on ymax and `steps` without (the order alternates between
 rounds), timing each block of O.run (wall clock) and the engine's own step (flow.core.step_times total, the C++
 step, which holds the call of the load). Reported: the median over rounds of the time per step with and without,
-their ratio less one, and the time of the load's Python call alone (measured inside it). No mesh or system is
+their ratio less one, the time of the load's Python call alone (measured inside it) and the core's
+pressure_field stage (taking the GIL, the position array, the call, the checks) as a share of the C++ step: the
+interleaved ratio is at the mercy of the machine's load, the stage is the cost itself. No mesh or system is
 built during the timed blocks (checked). No timing is asserted.
 """
 from __future__ import annotations
@@ -26,6 +28,7 @@ from yade.wrapper import ForceResetter, FrictMat, NewtonIntegrator
 from pfv import FlowEngine, waves
 
 SEED = 1
+STAGES = ("volumes", "pressure_field", "solve", "forces")
 
 
 def parse_args(argv: list[str]) -> dict:
@@ -85,7 +88,8 @@ def main() -> None:
     builds = (flow.core.remesh_count, flow.core.system_builds)
     per_step = {True: [], False: []}
     engine = {True: [], False: []}
-    load_seconds = []
+    stages = {True: {k: [] for k in STAGES}, False: {k: [] for k in STAGES}}
+    load_seconds, field_share = [], []
     for r in range(opts["rounds"]):
         for on in ((True, False) if r % 2 == 0 else (False, True)):
             if on:
@@ -93,16 +97,24 @@ def main() -> None:
             else:
                 flow.clear_boundary_pressure()
             seconds, calls = load.seconds, load.calls
-            inner = 0.0
+            inner = field = 0.0
+            parts = dict.fromkeys(STAGES, 0.0)
             t0 = time.perf_counter()
             for _ in range(opts["steps"]):
                 O.run(1, True)
-                inner += flow.core.step_times()["total"]
+                times = flow.core.step_times()
+                inner += times["total"]
+                field += times["pressure_field"]
+                for k in STAGES:
+                    parts[k] += times[k]
             per_step[on].append((time.perf_counter() - t0) / opts["steps"])
             engine[on].append(inner / opts["steps"])
+            for k in STAGES:
+                stages[on][k].append(parts[k] / opts["steps"])
             if on:
                 assert load.calls - calls == opts["steps"], "one call of the load per step"
                 load_seconds.append((load.seconds - seconds) / opts["steps"])
+                field_share.append(field / inner)
     assert (flow.core.remesh_count, flow.core.system_builds) == builds, "no mesh or system built while timed"
     without, with_load = statistics.median(per_step[False]), statistics.median(per_step[True])
     core_without, core_with = statistics.median(engine[False]), statistics.median(engine[True])
@@ -114,6 +126,11 @@ def main() -> None:
     print(f"wave_cost: C++ step per step   without {core_without * 1e3:.3f} ms, with {core_with * 1e3:.3f} ms, "
           f"ratio - 1 = {core_with / core_without - 1:+.2%}")
     print(f"wave_cost: the load's Python call {call * 1e6:.1f} us = {call / core_without:.2%} of the C++ step")
+    for on in (False, True):
+        print(f"wave_cost: stages {'with   ' if on else 'without'} " + ", ".join(
+            f"{k} {statistics.median(stages[on][k]) * 1e3:.3f} ms" for k in STAGES))
+    print(f"wave_cost: the core's pressure_field stage (GIL, arrays, the call, checks) = "
+          f"{statistics.median(field_share):.2%} of the C++ step")
 
 
 main()

@@ -366,7 +366,9 @@ void FlowEngine::assemble_rhs() {
 }
 
 void FlowEngine::apply_pressure_field() {
+  step_times_.pressure_field = 0;
   if (!pressure_field.active()) return;
+  const auto t0 = StageClock::now();
   LinearSystem& l = linear_;
   if (l.field_wall != pressure_field.wall) {
     // The wall's Dirichlet cells stay those of this system until it is rebuilt (which drops
@@ -395,6 +397,7 @@ void FlowEngine::apply_pressure_field() {
     next_pressure_[l.field_cells[i]] = field_values_[i];
   }
   ++field_evaluations_;
+  step_times_.pressure_field = seconds_since(t0);
 }
 
 void FlowEngine::solve() {

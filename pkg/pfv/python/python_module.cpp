@@ -41,6 +41,7 @@ py::dict times_dict(const StageTimes& t) {
   d["forces"] = t.forces;
   d["shear_geometry"] = t.shear_geometry;
   d["shear_forces"] = t.shear_forces;
+  d["pressure_field"] = t.pressure_field;
   d["total"] = t.total;
   return d;
 }

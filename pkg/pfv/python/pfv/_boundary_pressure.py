@@ -140,6 +140,8 @@ class BoundaryPressure:
         n = len(positions)
         p = function(positions[:, 0], positions[:, 1], positions[:, 2], self._field_time)
         try:
+            if p is None:  # numpy would take it for NaN
+                raise TypeError
             p = np.asarray(p, dtype=float)
         except (TypeError, ValueError):
             raise TypeError(f"{name}: the pressure function must return numbers, got {p!r:.80}") from None

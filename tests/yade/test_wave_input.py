@@ -4,8 +4,9 @@ each refusal is a Python exception naming the attribute or parameter, and leaves
     yade-double -n -x tests/yade/test_wave_input.py        (exit 0 = pass)
 
 Also: a scene without a load never calls into it (no evaluation, a zero pressure_field stage), a
-failed step leaves the engine's results as they were, and O.saveTmp / O.loadTmp keep waveAction and
-its two values.
+failed step leaves the engine's results as they were, O.saveTmp / O.loadTmp keep waveAction and
+its two values, and the load is evaluated once per step with background remeshes while the main
+thread queries the engine during O.run().
 """
 import math
 import os
@@ -114,7 +115,33 @@ rb.run(1)
 rb.check("waveAction off: bndCondValue again", flow.getBoundaryFlux(2) == q_ref or
          abs(flow.getBoundaryFlux(2) - q_ref) <= 1e-12 * abs(q_ref))
 
-# 4. The profiles' parameters.
+# 4. A background remesh (multithread) and queries from the main thread while O.run() steps.
+flow = rb.fresh(multithread=True, meshUpdateInterval=4)
+rb.run(1)
+wave = waves.StandingWave(0.5, period=30 * O.dt, length=1.0, mean=0.25)
+flow.set_boundary_pressure(flow.ymax, wave)
+meshes, evaluations = flow.core.remesh_count, flow.core.field_evaluations
+for _ in range(12):
+    rb.run(1)
+    flow.core.wait_for_remesh()  # adopted at the next step, whatever the machine's speed
+rb.check("background remeshes: one evaluation per step", flow.core.field_evaluations - evaluations == 12
+         and flow.core.remesh_count >= meshes + 2,
+         f"({flow.core.field_evaluations - evaluations} evaluations, {flow.core.remesh_count - meshes} remeshes)")
+evaluations = flow.core.field_evaluations
+O.run(16)
+queries = 0
+while O.running:
+    flow.getPorePressure((0.5, 0.5, 0.5))
+    queries += 1
+O.wait()
+rb.check("queries during O.run(): no deadlock, one evaluation per step",
+         flow.core.field_evaluations - evaluations == 16, f"({queries} queries)")
+t = O.time - O.dt
+top = np.nonzero(np.asarray(flow.core.cell_sources()) == flow.ymax)[0].tolist()
+deviation = max(abs(flow.getCellPressure(c) - float(wave(np.array(flow.getCellCenter(c)[0]), 0, 0, t))) for c in top)
+rb.check("background remeshes: the top holds the load of the last step", deviation <= 1e-14, f"({deviation:.2g})")
+
+# 5. The profiles' parameters.
 expect_error("HalfWave length = -1", ValueError, "length", lambda: waves.HalfWave(amplitude=1, length=-1))
 expect_error("HalfWave length = 0", ValueError, "length", lambda: waves.HalfWave(amplitude=1, length=0))
 expect_error("HalfWave rate = NaN", ValueError, "rate", lambda: waves.HalfWave(rate=NAN))

@@ -383,7 +383,7 @@ void FlowEngine::apply_pressure_field() {
       }
     l.field_wall = pressure_field.wall;
   }
-  if (l.field_cells.empty()) return;  // not a pressure wall (or every cell of it blocked)
+  if (l.field_cells.empty()) return;  // not a pressure wall, or each of its cells freed or blocked
   field_values_.clear();
   pressure_field.evaluate(l.field_at, field_values_);
   if (field_values_.size() != l.field_cells.size())

@@ -83,6 +83,12 @@ flow.set_boundary_pressure(flow.ymax, lambda x, y, z, t: 0.0)  # a number: broad
 rb.run(1)
 rb.check("a load returning a number holds everywhere", abs(flow.getBoundaryFlux(2) - q_ref) <= 1e-12 * abs(q_ref))
 
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    O.saveTmp("function")
+rb.check("O.saveTmp with a function set warns that it is not saved",
+         any("set_boundary_pressure is not saved" in str(w.message) for w in caught))
+
 # 3. waveAction and its values.
 expect_error("waveAction while a function is set", ValueError, "clear_boundary_pressure",
              lambda: setattr(flow, "waveAction", True))

@@ -134,6 +134,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     ++inversion_remeshes_;
     strain = assemble(centres, walls, dt);
   }
+  assemble_rhs();
   solve();
   compute_forces(centres, radii, dt);
   commit(centres, walls, strain);
@@ -353,13 +354,17 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
     for (int c = 0; c < nc; ++c)
       if (mesh_->cells.shape[c].n_walls == 0) volume_rate_[c] *= settings.volume_correction;
   step_times_.volumes = seconds_since(t0);
+  return max_change;
+}
 
+void FlowEngine::assemble_rhs() {
   // b = -dV/dt (+ V_f/(K dt) p^n, implicit Euler on the stored fluid) + imposed fluxes + the
   // couplings to the Dirichlet cells, whose pressures are this step's boundary values.
   next_pressure_ = pressure_;  // the iterative solvers' start
   const PressureSystem& system = linear_.system;
   apply_dirichlet_values(system, bc, next_pressure_);
   for (const auto& [c, p] : linear_.profile_pressure) next_pressure_[c] = p;
+  apply_pressure_field();
   const int nu = system.n_unknowns();
   rhs_.resize(nu);
   for (int u = 0; u < nu; ++u) rhs_[u] = -volume_rate_[system.unknown_cell[u]];
@@ -371,7 +376,41 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   }
   for (std::size_t i = 0; i < linear_.coupling_k.size(); ++i)
     rhs_[linear_.coupling_unknown[i]] += linear_.coupling_k[i] * next_pressure_[linear_.coupling_cell[i]];
-  return max_change;
+}
+
+void FlowEngine::apply_pressure_field() {
+  step_times_.pressure_field = 0;
+  if (!pressure_field.active()) return;
+  const auto t0 = StageClock::now();
+  LinearSystem& l = linear_;
+  if (l.field_wall != pressure_field.wall) {
+    // The wall's Dirichlet cells stay those of this system until it is rebuilt (which drops
+    // this list with it): gathered once, not at every step.
+    l.field_cells.clear();
+    l.field_at.clear();
+    const PressureSystem& s = l.system;
+    for (std::size_t c = 0; c < s.source.size(); ++c)
+      if (s.source[c] == pressure_field.wall) {
+        l.field_cells.push_back(static_cast<int>(c));
+        l.field_at.push_back(mesh_->cells.power_centre[c]);
+      }
+    l.field_wall = pressure_field.wall;
+  }
+  if (l.field_cells.empty()) return;  // not a pressure wall, or each of its cells freed or blocked
+  field_values_.clear();
+  pressure_field.evaluate(l.field_at, field_values_);
+  if (field_values_.size() != l.field_cells.size())
+    throw std::invalid_argument("the pressure field of wall " + std::to_string(pressure_field.wall) + " gave " +
+                                std::to_string(field_values_.size()) + " values for " +
+                                std::to_string(l.field_cells.size()) + " cells");
+  for (std::size_t i = 0; i < field_values_.size(); ++i) {
+    if (!std::isfinite(field_values_[i]))
+      throw std::invalid_argument("the pressure field of wall " + std::to_string(pressure_field.wall) +
+                                  " is not finite at " + describe(l.field_at[i]));
+    next_pressure_[l.field_cells[i]] = field_values_[i];
+  }
+  ++field_evaluations_;
+  step_times_.pressure_field = seconds_since(t0);
 }
 
 void FlowEngine::solve() {

@@ -21,6 +21,8 @@ class FlowEngine {
   // Changed freely between steps; the next step rebuilds whatever they make stale.
   EngineSettings settings;
   BoundaryConditions bc;
+  // Evaluated once per step (boundary_conditions.hpp); its values enter the right-hand side only.
+  PressureField pressure_field;
 
   FlowEngine() = default;
   FlowEngine(FlowEngine&&) = default;
@@ -162,6 +164,8 @@ class FlowEngine {
   int inversion_remeshes() const { return inversion_remeshes_; }
   // Linear systems adopted so far: one per remesh, plus one per rebuild without a remesh.
   int system_builds() const { return system_builds_; }
+  // Steps that evaluated the pressure_field so far.
+  int field_evaluations() const { return field_evaluations_; }
   double accumulated_strain() const { return strain_; }
   const SolveStats& last_solve() const { return last_solve_; }
   double refinement_contraction() const;  // -1 until measured, or without a 32-bit factor
@@ -186,6 +190,8 @@ class FlowEngine {
                        double dt);
   void rebuild_stale_system(double dt);
   double assemble(const std::vector<Vec3>& centres, const BoxWalls& walls, double dt);  // returns the pore strain
+  void assemble_rhs();  // once per step, on the mesh the step solves on
+  void apply_pressure_field();
   void solve();
   void compute_forces(const std::vector<Vec3>& centres, const std::vector<double>& radii, double dt);
   void commit(const std::vector<Vec3>& centres, const BoxWalls& walls, double strain);
@@ -221,6 +227,7 @@ class FlowEngine {
   std::vector<double> pressure_, volume_, volume_rate_, rhs_, solution_;
   std::vector<Vec3> force_;
   std::vector<double> next_volume_, next_pressure_;  // scratch of the step being computed
+  std::vector<double> field_values_;                 // scratch of apply_pressure_field
   std::vector<double> pressure_before_;              // the step before pressure_'s, on this mesh (extrapolated start)
   bool keep_trend_ = false;                          // the solver of this step wants the extrapolated start next
   std::vector<Vec3> next_force_;
@@ -234,6 +241,7 @@ class FlowEngine {
   int inverted_cells_ = 0;  // of the last assemble()
   int inversion_remeshes_ = 0;
   int system_builds_ = 0;
+  int field_evaluations_ = 0;
   SolveStats last_solve_;
   CellConditions cells_;                      // of the current mesh
   std::vector<double> measured_void_volume_;  // of the current mesh, by initialize_volumes (else empty)

@@ -52,6 +52,11 @@ struct LinearSystem {
   std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid
   // (cell, pressure) of the Dirichlet cells of bc.profile's wall; empty without a profile.
   std::vector<std::pair<int, double>> profile_pressure;
+  // The Dirichlet cells of the PressureField's wall and their power centres, gathered at the
+  // first step that needs them (field_wall: their wall, -1 before).
+  int field_wall = -1;
+  std::vector<int> field_cells;
+  std::vector<Vec3> field_at;
   SystemRecipe recipe;
   StageTimes times;  // assembly, analysis, factorization
 

@@ -1,6 +1,7 @@
 // Flow boundary conditions, with YADE's FlowEngine meanings.
 #pragma once
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "triangulation/box_walls.hpp"
@@ -23,6 +24,20 @@ struct PressureProfile {
   std::vector<double> position, pressure;  // positions increasing
   bool empty() const { return position.empty(); }
   bool operator==(const PressureProfile&) const = default;
+};
+
+// Pressures of one pressure wall's Dirichlet cells that change from step to step (YADE's
+// waveAction, pfv.waves). Called once per step, after any remesh, with the power centres of the
+// wall's Dirichlet cells; it fills one pressure per cell, which replaces the wall's value (and
+// any PressureProfile there). Only Dirichlet values change, i.e. the right-hand side: a time-
+// dependent load must never cost a new system or factor. Held by the engine, not in
+// BoundaryConditions, so that it is never copied into a background remesh (it may hold a Python
+// callable, which only the thread that holds the GIL may copy or drop).
+struct PressureField {
+  int wall = -1;  // -1: none
+  // (positions, pressures): pressures has one entry per position on return; may throw.
+  std::function<void(const std::vector<Vec3>&, std::vector<double>&)> evaluate;
+  bool active() const { return wall >= 0 && static_cast<bool>(evaluate); }
 };
 
 struct BoundaryConditions {

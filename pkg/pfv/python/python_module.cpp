@@ -41,6 +41,7 @@ py::dict times_dict(const StageTimes& t) {
   d["forces"] = t.forces;
   d["shear_geometry"] = t.shear_geometry;
   d["shear_forces"] = t.shear_forces;
+  d["pressure_field"] = t.pressure_field;
   d["total"] = t.total;
   return d;
 }
@@ -284,6 +285,34 @@ PYBIND11_MODULE(_core, m) {
           }),
           "(wall, axis, positions, pressures): the pressure along an axis of a pressure wall "
           "(boundary_conditions.hpp).")
+      .def(
+          "set_pressure_field",
+          [](SharedEngine& e, int wall, py::object fn) {
+            if (wall < -1 || wall >= kWallCount) throw py::value_error("wall must be in 0..5 (or -1: none)");
+            PressureField field;
+            if (wall >= 0 && !fn.is_none()) {
+              if (!PyCallable_Check(fn.ptr())) throw py::type_error("the pressure field must be callable");
+              field.wall = wall;
+              // Runs inside step(), which released the GIL: take it back for the call only.
+              field.evaluate = [fn = std::move(fn)](const std::vector<Vec3>& at, std::vector<double>& p) {
+                py::gil_scoped_acquire gil;
+                const Array values = fn(points_to_array(at)).cast<Array>();
+                if (values.ndim() != 1 || values.shape(0) != static_cast<py::ssize_t>(at.size()))
+                  throw py::value_error("the pressure field must return one pressure per position");
+                p.assign(values.data(), values.data() + values.shape(0));
+              };
+            }
+            // The old field (maybe a Python callable) is dropped here, with the GIL held.
+            const auto lock = hold(e);
+            std::swap(e.pressure_field, field);
+          },
+          py::arg("wall"), py::arg("field"),
+          "field(positions (n, 3)) -> n pressures of the Dirichlet cells of `wall`, called once per step (the\n"
+          "right-hand side only: no new system); None or wall -1: none. It must not call the engine.")
+      .def_property_readonly("pressure_field_wall",
+                             exclusive([](const SharedEngine& e) { return e.pressure_field.wall; }))
+      .def_property_readonly("field_evaluations", exclusive(&FlowEngine::field_evaluations),
+                             "Steps that evaluated the pressure field so far.")
       .def("impose_pressure", exclusive([](SharedEngine& e, const std::array<double, 3>& x, double p) {
              return add_point_condition(e, e.bc.imposed_pressure, {Vec3(x[0], x[1], x[2]), p});
            }))

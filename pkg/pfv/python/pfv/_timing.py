@@ -16,7 +16,8 @@ _REMESH_STAGES = (("triangulation", "remesh: triangulation"), ("geometry", "reme
                   ("conductance", "remesh: conductances"), ("force_cache", "remesh: force cache"),
                   ("shear_geometry", "remesh: shear pairs"), ("assembly", "system: assembly"),
                   ("analysis", "system: ordering"), ("factorization", "system: factorization"))
-_STEP_STAGES = (("volumes", "dV/dt"), ("solve", "solve"), ("forces", "forces"), ("shear_forces", "shear forces"))
+_STEP_STAGES = (("volumes", "dV/dt"), ("pressure_field", "boundary pressure"), ("solve", "solve"), ("forces", "forces"),
+                ("shear_forces", "shear forces"))
 
 
 class StageTimings:

@@ -9,9 +9,10 @@ An attribute YADE's FlowEngine has but PFV does not support may only be set to Y
 default value; any other value raises NotImplementedError naming it. Misspelt names raise
 AttributeError. Nothing is silently ignored.
 
-This module holds the engine class, which composes four parts: the attribute surface
+This module holds the engine class, which composes five parts: the attribute surface
 (``_attributes``), the scan of YADE's bodies (``_scene_scan.SceneScan``), the time-step
-guard (``_time_step.TimeStepGuard``) and the members on single cells (``_cell_interface``, a mixin).
+guard (``_time_step.TimeStepGuard``), the members on single cells (``_cell_interface``, a mixin)
+and the time-dependent boundary pressures (``_boundary_pressure``, a mixin; ``pfv.waves``).
 """
 from __future__ import annotations
 
@@ -34,6 +35,7 @@ from yade.minieigenHP import Vector3
 
 from . import _attributes as attributes
 from . import _persistence
+from ._boundary_pressure import FIELD_INTERNAL, BoundaryPressure
 from ._locking import exclusive as _exclusive
 from ._cell_interface import CELL_CACHES, CELL_INTERNAL, CellInterface
 from ._core import Engine, set_num_threads
@@ -121,7 +123,7 @@ _INTERNAL = frozenset({
     "_warned",                # the one-time warnings given
     "_threads",               # ompThreads, None: follow YADE's -j
     "_use_sphere_pack",       # False: always read the coordinate lists
-}) | CELL_INTERNAL
+}) | CELL_INTERNAL | FIELD_INTERNAL
 
 
 def _guard_setting(name: str, doc: str) -> property:
@@ -130,7 +132,7 @@ def _guard_setting(name: str, doc: str) -> property:
                     doc=doc)
 
 
-class FlowEngine(CellInterface, PyRunner):
+class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
     """PFV's DEM-PFV flow engine with the interface of YADE's FlowEngine."""
 
     xmin, xmax, ymin, ymax, zmin, zmax = range(6)
@@ -371,6 +373,8 @@ class FlowEngine(CellInterface, PyRunner):
             self._correct_volumes(pos, scan.radii)
         if clock:
             clock.lap("time-step guard")
+        if self._pressure_function is not None:
+            self._prepare_pressure(scene, walls)
         with self._bodies_named(scan):
             if self._block_hook and remeshing and not core.background_remesh:
                 self._remesh_for_block_hook(pos, scan, walls)  # blockHook, between the mesh and its system
@@ -623,6 +627,10 @@ class FlowEngine(CellInterface, PyRunner):
         the Python-side settings and, once it has run, the core's run state."""
         core = self._core
         running = core.has_mesh() and self._stepped is not None
+        if self.boundary_pressure is not None and "unsaved function" not in self._warned:
+            self._warned.add("unsaved function")
+            warnings.warn("pfv.FlowEngine: the function of set_boundary_pressure is not saved with the scene; "
+                          "set it again after O.load", stacklevel=3)
         return {
             "core": {name: getattr(core, name) for name in _SAVED_CORE_SETTINGS},
             "bnd_is_pressure": list(core.bnd_is_pressure),
@@ -634,6 +642,8 @@ class FlowEngine(CellInterface, PyRunner):
             "threads": self._threads,
             "use_sphere_pack": self._use_sphere_pack,
             "mixin": {name: getattr(self, name) for name in sorted(CELL_INTERNAL - CELL_CACHES)},
+            "waves": {"wave_action": self._wave_action, "sine_magnitude": self._sine_magnitude,
+                      "sine_average": self._sine_average},
             "guard": {name: getattr(self._guard, name) for name in _SAVED_GUARD_SETTINGS},
             "runner": {name: getattr(self, name) for name in ("iterPeriod", "dead", "initRun")},
             "last_step": list(self._last_step) if running and self._last_step else None,
@@ -659,6 +669,10 @@ class FlowEngine(CellInterface, PyRunner):
         engine._use_sphere_pack = state["use_sphere_pack"]
         for name, value in state["mixin"].items():
             setattr(engine, name, _as_tuples(value))
+        waves = state.get("waves", {})
+        engine.sineMagnitude = waves.get("sine_magnitude", 0.0)
+        engine.sineAverage = waves.get("sine_average", 0.0)
+        engine.waveAction = waves.get("wave_action", False)
         for name, value in state["guard"].items():
             setattr(engine._guard, name, value)
         for name, value in state["runner"].items():

@@ -119,7 +119,7 @@ PYBIND11_MODULE(_core, m) {
       .def(
           "apply",
           [](const YadeForceBridge& b, py::handle add, const SharedEngine& engine) {
-            const auto lock = hold(engine);
+            const EngineLock lock(engine);
             const std::vector<Vec3>& f = engine.forces();
             static_assert(sizeof(Vec3) == 3 * sizeof(double), "rows of three doubles");
             b.apply(add, f.empty() ? nullptr : f.front().data(), f.size());
@@ -303,7 +303,7 @@ PYBIND11_MODULE(_core, m) {
               };
             }
             // The old field (maybe a Python callable) is dropped here, with the GIL held.
-            const auto lock = hold(e);
+            const EngineLock lock(e);
             std::swap(e.pressure_field, field);
           },
           py::arg("wall"), py::arg("field"),

@@ -7,9 +7,11 @@
 #include <pybind11/pybind11.h>
 
 #include <array>
+#include <atomic>
 #include <cstring>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -55,24 +57,40 @@ inline BoxWalls to_walls(const std::array<double, 6>& w) {
 // main thread may arrive while a step rebuilds the mesh. Every call into the engine takes its
 // lock; a caller that must wait does so with the GIL released (a step releases the GIL while it
 // runs, and never needs it while it holds the lock), so the two threads cannot deadlock.
+// A call from the thread that holds the lock (a boundary-pressure function calling the engine
+// during the step that calls it) would wait for itself forever: it raises instead.
 struct SharedEngine : FlowEngine {
   mutable std::mutex busy;
+  mutable std::atomic<std::thread::id> holder{};
 };
 
-inline std::unique_lock<std::mutex> hold(const SharedEngine& e) {
-  std::unique_lock<std::mutex> lock(e.busy, std::try_to_lock);
-  if (!lock.owns_lock()) {
-    py::gil_scoped_release release;
-    lock.lock();
+class EngineLock {
+ public:
+  explicit EngineLock(const SharedEngine& e) : engine_(e), lock_(e.busy, std::defer_lock) {
+    if (e.holder.load() == std::this_thread::get_id())
+      throw std::runtime_error(
+          "pfv.Engine called from inside its own step (a boundary-pressure function must not call the engine; "
+          "compute what it needs before the step)");
+    if (!lock_.try_lock()) {
+      py::gil_scoped_release release;
+      lock_.lock();
+    }
+    e.holder.store(std::this_thread::get_id());
   }
-  return lock;
-}
+  ~EngineLock() { engine_.holder.store(std::thread::id{}); }  // before the lock is released
+  EngineLock(const EngineLock&) = delete;
+  EngineLock& operator=(const EngineLock&) = delete;
+
+ private:
+  const SharedEngine& engine_;
+  std::unique_lock<std::mutex> lock_;
+};
 
 // f(engine, args...) under the engine's lock, for a lambda taking the engine first ...
 template <class F, class R, class Self, class... A>
 auto exclusive_call(F f, R (F::*)(Self, A...) const) {
   return [f = std::move(f)](Self e, A... a) -> R {
-    const auto lock = hold(e);
+    const EngineLock lock(e);
     return f(e, std::forward<A>(a)...);
   };
 }
@@ -84,14 +102,14 @@ auto exclusive(F f) {
 template <class R, class... A>
 auto exclusive(R (FlowEngine::*m)(A...) const) {
   return [m](const SharedEngine& e, A... a) -> R {
-    const auto lock = hold(e);
+    const EngineLock lock(e);
     return (e.*m)(std::forward<A>(a)...);
   };
 }
 template <class R, class... A>
 auto exclusive(R (FlowEngine::*m)(A...)) {
   return [m](SharedEngine& e, A... a) -> R {
-    const auto lock = hold(e);
+    const EngineLock lock(e);
     return (e.*m)(std::forward<A>(a)...);
   };
 }

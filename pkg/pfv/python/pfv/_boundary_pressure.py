@@ -88,8 +88,8 @@ class BoundaryPressure:
         e.g. flow.ymax): once per step it is called with numpy arrays of the x, y, z of the power centres of
         the wall's Dirichlet cells and t = O.time, and must return one finite pressure per cell (an array
         of their shape, or a number); these replace bndCondValue[wall] in the right-hand side only (no new
-        system). pfv.waves has the thesis' profiles. It must not call the engine. One load per engine:
-        this replaces the previous one."""
+        system). pfv.waves has the thesis' profiles. It must not call the engine (that raises RuntimeError).
+        One load per engine: this replaces the previous one."""
         if isinstance(wall, bool) or not isinstance(wall, int):
             raise TypeError(f"set_boundary_pressure wall must be a wall index 0..5 (e.g. flow.ymax), got {wall!r}")
         if not 0 <= wall < 6:

@@ -17,20 +17,20 @@ reading the engine (under its lock), building the VTK grids and writing them. No
 """
 from __future__ import annotations
 
-import math
 import os
 import shutil
 import statistics
 import sys
 import time
 
-import numpy as np
 
-from yade import O, utils
-from yade.wrapper import FlowEngine as YadeFlowEngine, ForceResetter, FrictMat, NewtonIntegrator
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # bench/
+from lattice import jittered_lattice  # noqa: E402
+from yade import O, utils  # noqa: E402
+from yade.wrapper import FlowEngine as YadeFlowEngine, ForceResetter, FrictMat, NewtonIntegrator  # noqa: E402
 
-import pfv
-from pfv import FlowEngine as PfvFlowEngine, _vtk_output
+import pfv  # noqa: E402
+from pfv import FlowEngine as PfvFlowEngine, _vtk_output  # noqa: E402
 
 SEED = 1
 
@@ -59,20 +59,8 @@ def parse_args(argv: list[str]) -> dict:
     return opts
 
 
-def lattice(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Centres and radii of n spheres on a jittered cubic lattice (the first n sites, layer by layer)."""
-    side = round(n ** (1 / 3))
-    layers = math.ceil(n / side ** 2)
-    i, j, k = np.meshgrid(np.arange(side), np.arange(layers), np.arange(side), indexing="ij")
-    sites = np.column_stack([i.ravel(), j.ravel(), k.ravel()])[:n].astype(float) + 0.5
-    rng = np.random.default_rng(SEED)
-    centres = sites + rng.uniform(-0.03, 0.03, size=sites.shape)
-    radii = 0.42 * (1 + rng.uniform(-0.1, 0.1, size=n))
-    return centres, radii
-
-
 def build_scene(n: int) -> tuple[YadeFlowEngine, PfvFlowEngine]:
-    centres, radii = lattice(n)
+    centres, radii = jittered_lattice(n, SEED)
     O.reset()
     O.materials.append(FrictMat(young=1e6, poisson=0.5, frictionAngle=0.5, density=2600, label="spheres"))
     lo = (centres - radii[:, None]).min(axis=0)

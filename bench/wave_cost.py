@@ -15,17 +15,18 @@ built during the timed blocks (checked). No timing is asserted.
 """
 from __future__ import annotations
 
-import math
+import os
 import statistics
 import sys
 import time
 
-import numpy as np
 
-from yade import O, utils
-from yade.wrapper import ForceResetter, FrictMat, NewtonIntegrator
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # bench/
+from lattice import jittered_lattice  # noqa: E402
+from yade import O, utils  # noqa: E402
+from yade.wrapper import ForceResetter, FrictMat, NewtonIntegrator  # noqa: E402
 
-from pfv import FlowEngine, waves
+from pfv import FlowEngine, waves  # noqa: E402
 
 SEED = 1
 STAGES = ("volumes", "pressure_field", "solve", "forces")
@@ -41,15 +42,6 @@ def parse_args(argv: list[str]) -> dict:
             raise SystemExit(f"wave_cost: unknown option --{key}")
         opts[key] = int(value)
     return opts
-
-
-def lattice(n: int) -> tuple[np.ndarray, np.ndarray]:
-    side = round(n ** (1 / 3))
-    layers = math.ceil(n / side ** 2)
-    i, j, k = np.meshgrid(np.arange(side), np.arange(layers), np.arange(side), indexing="ij")
-    sites = np.column_stack([i.ravel(), j.ravel(), k.ravel()])[:n].astype(float) + 0.5
-    rng = np.random.default_rng(SEED)
-    return sites + rng.uniform(-0.03, 0.03, size=sites.shape), 0.42 * (1 + rng.uniform(-0.1, 0.1, size=n))
 
 
 class Timed:
@@ -68,7 +60,7 @@ class Timed:
 
 def main() -> None:
     opts = parse_args(sys.argv[1:])
-    centres, radii = lattice(opts["spheres"])
+    centres, radii = jittered_lattice(opts["spheres"], SEED)
     O.reset()
     O.materials.append(FrictMat(young=1e6, poisson=0.5, frictionAngle=0.5, density=2600, label="spheres"))
     lo, hi = (centres - radii[:, None]).min(axis=0), (centres + radii[:, None]).max(axis=0)

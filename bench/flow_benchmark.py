@@ -697,7 +697,7 @@ def startup_report(opts, machine, rows, command, started, finished, threads):
       'steps, **remesh** = the same from a forced remesh (`updateTriangulation=True`) of that engine; medians over '
       'rounds of the per-trial values (the ratio first/remesh per trial). Targets: first/remesh <= 1.2, first PFV / '
       'first YADE <= 0.5.' % (command, started, finished, machine.get('Model name', '?'), threads, threads,
-                               opts['rounds'], opts['steady'], WINDOW, WINDOW - 1))
+                              opts['rounds'], opts['steady'], WINDOW, WINDOW - 1))
     w('')
     w('| N | cells | first step YADE | first step PFV | remesh PFV | **first / remesh PFV** (range) | '
       '**first PFV / first YADE** | CPU/wall steady Y / P |')
@@ -721,8 +721,8 @@ def startup_report(opts, machine, rows, command, started, finished, threads):
         w('| %s | %s | %d / %d | %.3g |' % (n, ' | '.join(cells), pp['applications'][0], pp['applications'][1],
                                             pp['factor nonzeros'][0]))
     w('')
-    w('Load average (1, 5, 15 min) at start: %s; at end: %s.' % (machine['load average at start'],
-                                                              machine['load average at end']))
+    w('Load average (1, 5, 15 min) at start: %s; at end: %s.'
+      % (machine['load average at start'], machine['load average at end']))
     return '\n'.join(L)
 
 

@@ -87,7 +87,8 @@ class FlowEngine {
   // (groups of spheres squeezing shared pores) make this smaller than the thesis'
   // single-particle dt_MV. Needs a mesh (viscous_stability.cpp).
   // Without a mode: Arnoldi from a fixed start, at most 'iterations' operator applications,
-  // stopping once the largest Ritz value changes by less than 1e-6. mode: if given with one
+  // stopping once the largest Ritz value changes by less than 1e-6 or its residual is below
+  // 1e-3 of it (at least 8 applications). mode: if given with one
   // entry per sphere (not all zero), power iteration starts from it instead (warm start from
   // the previous mesh's mode, stopping once the estimate changes by less than 0.5 %). On
   // return mode holds the estimated eigenvector (unit norm), and applications (if given) the

@@ -89,6 +89,9 @@ class CholmodSolver {
   // reuses it when the new factor fits (see values_).
   void release();
   std::size_t value_capacity() const { return value_capacity_; }  // doubles, 0 before any factor
+  struct FreeValues {  // the deleter of the values' storage (std::free: see lend_values)
+    void operator()(double* p) const;
+  };
 
  private:
   void solve_on(const std::vector<double>& rhs, std::vector<double>& x, bool threads);
@@ -106,8 +109,9 @@ class CholmodSolver {
   // every factorisation). A factor of tens of thousands of spheres takes hundreds of MB;
   // glibc serves blocks that large from new mappings, whose first touch faults in every
   // page. Kept across release(), it makes the pages of one remesh the pages of the next. Only grown, with 1/8 headroom
-  // for the next remeshes.
-  std::unique_ptr<double[]> values_;
+  // for the next remeshes. A large block is aligned to 2 MB and offered to the kernel for transparent huge pages
+  // (lend_values), so that the first factorisation faults in a few large pages rather than one per 4 kB.
+  std::unique_ptr<double[], FreeValues> values_;
   std::size_t value_capacity_ = 0;
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
   std::vector<double> scale_;          // per column (elimination order) with kScaled32; empty in double

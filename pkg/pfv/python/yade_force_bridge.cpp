@@ -46,14 +46,14 @@ constexpr const char* kForceAddSymbol =
 }  // namespace
 
 YadeForceBridge::YadeForceBridge(py::object vector3_type, const py::array_t<long long>& ids,
-                                 const py::array_t<long long>& rows) {
+                                 const py::array_t<long long>& rows)
+    : vector3_type_(std::move(vector3_type)) {
   const auto id = ids.unchecked<1>();
   const auto row = rows.unchecked<1>();
   if (row.shape(0) != id.shape(0)) throw py::value_error("one force row per body id is needed");
-  ids_.reserve(id.shape(0));
+  id_values_.reserve(id.shape(0));
   for (py::ssize_t i = 0; i < id.shape(0); ++i) {
     if (row(i) < 0) throw py::value_error("negative force row");
-    ids_.push_back(py::int_(id(i)));
     id_values_.push_back(static_cast<long>(id(i)));
     rows_.push_back(row(i));
   }
@@ -68,10 +68,17 @@ YadeForceBridge::YadeForceBridge(py::object vector3_type, const py::array_t<long
     force_add_ = nullptr;
   }
 #endif
+}
+
+void YadeForceBridge::prepare_fallback() const {
+  if (fallback_ready_) return;
+  fallback_ready_ = true;
+  ids_.reserve(id_values_.size());
+  for (long id : id_values_) ids_.push_back(py::int_(id));
   std::vector<double*> storage;
   vectors_.reserve(ids_.size());
   for (std::size_t i = 0; i < ids_.size(); ++i) {
-    vectors_.push_back(vector3_type(0.0, 0.0, 0.0));
+    vectors_.push_back(vector3_type_(0.0, 0.0, 0.0));
     double* s = storage_of(vectors_.back());
     if (!s) return;  // tuples then
     storage.push_back(s);
@@ -124,7 +131,7 @@ void YadeForceBridge::apply(py::handle add, const double* forces, std::size_t co
 #ifdef PFV_HAVE_BOOST_PYTHON
   if (void* container = direct_target(add)) {
     try {
-      for (std::size_t i = 0; i < ids_.size(); ++i) {
+      for (std::size_t i = 0; i < id_values_.size(); ++i) {
         const py::ssize_t row = rows_[i];
         const double value[3] = {f(row, 0), f(row, 1), f(row, 2)};
         force_add_(container, id_values_[i], value, false);
@@ -135,6 +142,7 @@ void YadeForceBridge::apply(py::handle add, const double* forces, std::size_t co
     return;
   }
 #endif
+  prepare_fallback();
   PyObject* fn = add.ptr();
   for (std::size_t i = 0; i < ids_.size(); ++i) {
     const py::ssize_t row = rows_[i];

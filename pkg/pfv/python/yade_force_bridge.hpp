@@ -8,7 +8,9 @@
 // through Boost.Python's converter registry, which YADE's bindings populate. Same function, same
 // arguments as addF, about a fifth of the cost (doc/yade.md). Failing that (another
 // YADE, PFV built without Boost.Python), one addF call per body with a YADE Vector3 owned by the
-// bridge and written in place (half the cost of a tuple), or with tuples.
+// bridge and written in place (half the cost of a tuple), or with tuples. The fallback's Python
+// objects (one Vector3 and one int per body, 60 ms at 10 000 bodies, all of it on the first step
+// of an engine) are made on its first use only: the direct call needs none of them.
 #pragma once
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -29,22 +31,30 @@ class YadeForceBridge {
   void apply(pybind11::handle add, const Forces& forces) const;
   // The same from count rows of three doubles (the engine's own force array: no copy to numpy).
   void apply(pybind11::handle add, const double* forces, std::size_t count) const;
-  bool writes_in_place() const { return !storage_.empty(); }
+  bool writes_in_place() const {
+    prepare_fallback();
+    return !storage_.empty();
+  }
   // Whether apply(O.forces.addF, ...) calls YADE's force_add directly.
   bool calls_yade_directly() const { return force_add_ != nullptr; }
-  std::size_t size() const { return ids_.size(); }
+  std::size_t size() const { return id_values_.size(); }
 
  private:
   using ForceAdd = void (*)(void* container, long id, const double (&f)[3], bool permanent);
   // The target of a bound O.forces.addF, or nullptr if it cannot be called directly.
   void* direct_target(pybind11::handle add) const;
+  // Makes ids_, vectors_ and storage_ once (the fallback of apply; see the top of the file).
+  // Mutable state behind const: the bridge is used under the engine's lock, never concurrently.
+  void prepare_fallback() const;
 
   std::unique_ptr<void, int (*)(void*)> wrapper_module_{nullptr, nullptr};  // dlopen handle
   ForceAdd force_add_ = nullptr;
   std::vector<long> id_values_;
-  std::vector<pybind11::object> ids_, vectors_;
   std::vector<pybind11::ssize_t> rows_;
-  std::vector<double*> storage_;  // x, y, z of vectors_[i]; empty: pass tuples
+  pybind11::object vector3_type_;
+  mutable bool fallback_ready_ = false;
+  mutable std::vector<pybind11::object> ids_, vectors_;
+  mutable std::vector<double*> storage_;  // x, y, z of vectors_[i]; empty: pass tuples
 };
 
 }  // namespace pfv

@@ -449,8 +449,9 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
         single-particle dt_MV overestimates (0.3-0.5 dt_MV measured on dense packings).
         Computed on every new mesh and when the viscosity changes: on the first mesh by Arnoldi
         from a fixed start (at most collective_iterations = 40 operator applications, stopping
-        once the estimate settles to 1e-6), afterwards by power iteration started from the
-        previous mesh's mode (at most collective_iterations_warm = 10). Each operator application
+        once the estimate settles to 1e-6 or its Arnoldi residual is below 1e-3 of it), afterwards
+        by power iteration started from the previous mesh's mode (at most
+        collective_iterations_warm = 10). Each operator application
         costs one back-substitution and one force evaluation; see collective_viscous_history
         ("iterations" there is the count made, "max_iterations" the cap, "seconds" the cost)."""
         with self._lock:

@@ -33,8 +33,10 @@ void validate(const EngineSettings& s) {
   require(finite_positive(c.max_ratio) && c.max_ratio >= c.min_ratio,
           named("maxKdivKmean", c.max_ratio, "finite and at least minKdivKmean"));
   require(s.solver == SolverKind::kGaussSeidel || s.solver == SolverKind::kConjugateGradient ||
-              s.solver == SolverKind::kCholesky,
-          "solver must be Gauss-Seidel, conjugate gradients or Cholesky");
+              s.solver == SolverKind::kCholesky || s.solver == SolverKind::kMultigrid || s.solver == SolverKind::kAuto,
+          "solver must be Gauss-Seidel, conjugate gradients, Cholesky, multigrid or auto");
+  require(std::isfinite(s.max_factor_bytes) && s.max_factor_bytes >= 0,
+          named("max_factor_bytes", s.max_factor_bytes, "finite and >= 0 (0: from the memory available)"));
   // A tolerance of zero never stops Gauss-Seidel and NaN stops conjugate gradients at once.
   require(finite_positive(s.tolerance) && s.tolerance < 1, named("tolerance", s.tolerance, "in (0, 1)"));
   require(s.relax > 0 && s.relax < 2, named("relax", s.relax, "in (0, 2)"));

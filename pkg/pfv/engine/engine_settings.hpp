@@ -16,8 +16,14 @@ struct EngineSettings {
   // (conductance x 0.71 and x 0.5). Not in the thesis, and further from Stokes flow
   // (doc/validation.md section 7); for matching results of YADE's engine.
   bool yade_wall_throat_factor = false;
-  SolverKind solver = SolverKind::kCholesky;
-  double tolerance = 1e-6;  // iterative solvers
+  // kAuto: the Cholesky factor unless its analysis projects more stored values than fit in
+  // max_factor_bytes (linear_system.hpp), else multigrid.
+  SolverKind solver = SolverKind::kAuto;
+  // The largest Cholesky factor kAuto accepts, in bytes (8 per stored value: factorised in
+  // double); 0: half the memory available (MemAvailable) when the system is built, plus the
+  // storage of the factor it replaces.
+  double max_factor_bytes = 0;
+  double tolerance = 1e-6;  // Gauss-Seidel, incomplete-Cholesky CG
   double relax = 1.9;       // Gauss-Seidel
   int max_iterations = 200000;
   bool force_metis = false;  // YADE's forceMetis: METIS ordering whatever 'ordering' says
@@ -77,7 +83,8 @@ struct EngineSettings {
   }
   // Whether a remesh carries the old mesh's cell states over (see interpolate_on_remesh).
   bool interpolates() const {
-    return solver != SolverKind::kCholesky || fluid_bulk_modulus > 0 || interpolate_on_remesh;
+    return solver == SolverKind::kGaussSeidel || solver == SolverKind::kConjugateGradient ||
+           solver == SolverKind::kMultigrid || fluid_bulk_modulus > 0 || interpolate_on_remesh;
   }
   // The ordering CHOLMOD is asked for.
   Ordering factor_ordering() const { return force_metis ? Ordering::kMetis : ordering; }

@@ -159,6 +159,10 @@ class FlowEngine {
   const CholmodSolver& cholmod() const;
   // The current system's Cholesky solver, or nullptr (another solver, or no system yet).
   const CholeskySolver* cholesky() const { return linear_.cholesky(); }
+  // The current system's solver, null before the first step.
+  const PressureSolver* pressure_solver() const { return linear_.solver.get(); }
+  // Which solver the current system uses and why (LinearSystem::choice); empty before.
+  const std::string& solver_choice() const { return linear_.choice; }
   int remesh_count() const { return remesh_count_; }
   // Remeshes forced because the spheres had turned cells inside out since the last remesh
   // (motion too large for the remesh schedule); each also counts in remesh_count().

@@ -1,11 +1,14 @@
 #include "pfv/engine/linear_system.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
 #include "pfv/common/stage_timer.hpp"
+#include "pfv/linalg/amg_solver.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/linalg/gauss_seidel_solver.hpp"
 #include "pfv/linalg/pcg_solver.hpp"
@@ -58,10 +61,43 @@ std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
       return std::make_unique<GaussSeidelSolver>();
     case SolverKind::kConjugateGradient:
       return std::make_unique<PcgSolver>();
+    case SolverKind::kMultigrid:
+      return std::make_unique<AmgSolver>();
     case SolverKind::kCholesky:
+    case SolverKind::kAuto:
       break;
   }
   return std::make_unique<CholeskySolver>();
+}
+
+// MemAvailable of /proc/meminfo in bytes (the kernel's estimate of what can be allocated
+// without swapping); 0 if unreadable.
+double memory_available() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  double kib = 0;
+  std::string unit;
+  while (in >> key >> kib >> unit)
+    if (key == "MemAvailable:") return kib * 1024;
+  return 0;
+}
+
+// The bound on the values of a Cholesky factor under SolverKind::kAuto.
+double factor_entry_budget(const EngineSettings& s, const PressureSolver* recycled) {
+  double bytes = s.max_factor_bytes;
+  if (bytes == 0) {
+    bytes = 0.5 * memory_available();
+    if (const auto* c = dynamic_cast<const CholeskySolver*>(recycled))
+      bytes += static_cast<double>(c->factor().value_capacity()) * sizeof(double);  // reused, not new
+    if (bytes == 0) return std::numeric_limits<double>::infinity();                 // no /proc: no bound
+  }
+  return bytes / sizeof(double);
+}
+
+std::string bytes_text(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g GB", bytes / 1e9);
+  return text;
 }
 
 }  // namespace
@@ -72,6 +108,7 @@ SystemRecipe::SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc
       ordering(s.factor_ordering()),
       mixed_precision(s.mixed_precision),
       mixed_precision_min_entries(s.mixed_precision_min_entries),
+      max_factor_bytes(s.max_factor_bytes),
       fluid_bulk_modulus(s.fluid_bulk_modulus),
       minimum_porosity(s.minimum_porosity),
       dt(step),
@@ -85,9 +122,11 @@ bool SystemRecipe::stale_for(const EngineSettings& s, const BoundaryConditions& 
       is_pressure != bc.is_pressure)
     return true;
   if (fluid_bulk_modulus > 0 && (dt != step || minimum_porosity != s.minimum_porosity)) return true;
-  if (solver == SolverKind::kCholesky && (ordering != s.factor_ordering() || mixed_precision != s.mixed_precision ||
-                                          mixed_precision_min_entries != s.mixed_precision_min_entries))
+  const bool factor = solver == SolverKind::kCholesky || solver == SolverKind::kAuto;
+  if (factor && (ordering != s.factor_ordering() || mixed_precision != s.mixed_precision ||
+                 mixed_precision_min_entries != s.mixed_precision_min_entries))
     return true;
+  if (solver == SolverKind::kAuto && max_factor_bytes != s.max_factor_bytes) return true;
   if (imposed_pressure_at.size() != bc.imposed_pressure.size() || imposed_flux_at.size() != bc.imposed_flux.size() ||
       !(profile == bc.profile))
     return true;
@@ -106,7 +145,14 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
                                  CellState cells) {
   LinearSystem l;
   l.recipe = SystemRecipe(settings, bc, dt);
-  l.solver = recycled && recycled->kind() == settings.solver ? std::move(recycled) : make_solver(settings.solver);
+  // Under kAuto a multigrid solver carried over keeps the choice made for the earlier mesh of
+  // this engine (of a like size): every analysis that would only confirm it costs an ordering.
+  const bool automatic = settings.solver == SolverKind::kAuto;
+  const bool keep =
+      recycled && (recycled->kind() == settings.solver || (automatic && (recycled->kind() == SolverKind::kCholesky ||
+                                                                         recycled->kind() == SolverKind::kMultigrid)));
+  const double budget = automatic ? factor_entry_budget(settings, recycled.get()) : 0;
+  l.solver = keep ? std::move(recycled) : make_solver(settings.solver);
   if (settings.fluid_bulk_modulus > 0) {
     const int nc = m.mesh().n_cells();
     const bool measured = cells.void_volume && static_cast<int>(cells.void_volume->size()) == nc;
@@ -157,7 +203,20 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
         options.given.max_fill = settings.max_fill_growth * previous->fresh_fill();
         options.given.from_metis = previous->from_metis();
       }
-      cholesky->setup(s, options);
+      if (automatic) options.max_entries = budget;
+      try {
+        cholesky->setup(s, options);
+        if (automatic)
+          l.choice = "cholesky: the factor stores " + bytes_text(cholesky->factor().factor_nonzeros() * 8) +
+                     ", within the budget of " + bytes_text(budget * 8);
+      } catch (const FactorTooLarge& e) {
+        l.choice = "multigrid: the Cholesky factor would store " + bytes_text(e.entries * 8) +
+                   ", more than the budget of " + bytes_text(budget * 8);
+        l.solver = std::make_unique<AmgSolver>();
+        l.times.analysis = seconds_since(t0);
+      }
+    }
+    if (CholeskySolver* cholesky = l.cholesky()) {
       const CholmodSolver& f = cholesky->factor();
       // The refinement's residual reads G by rows; a double factor never does.
       if (f.reduced_precision()) index_rows(l.system);
@@ -168,9 +227,13 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       l.times.analysis = f.analysis_seconds();
     } else if (auto* pcg = dynamic_cast<PcgSolver*>(l.solver.get())) {
       pcg->setup(s);
+    } else if (auto* amg = dynamic_cast<AmgSolver*>(l.solver.get())) {
+      if (automatic && l.choice.empty()) l.choice = "multigrid: kept from the previous mesh";
+      amg->setup(s);
     }
   }
   l.times.factorization = seconds_since(t0) - l.times.analysis;
+  if (l.choice.empty()) l.choice = std::string(to_string(l.solver->kind())) + ": as set";
   return l;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -28,6 +29,7 @@ struct SystemRecipe {
   Ordering ordering = Ordering::kAuto;  // Cholesky only
   bool mixed_precision = false;         // Cholesky only
   double mixed_precision_min_entries = 0;
+  double max_factor_bytes = 0;  // kAuto only
   double fluid_bulk_modulus = 0;
   double minimum_porosity = 0;  // enters G only with a compressible fluid
   double dt = 0;                // likewise
@@ -58,6 +60,8 @@ struct LinearSystem {
   std::vector<int> field_cells;
   std::vector<Vec3> field_at;
   SystemRecipe recipe;
+  // The solver built and why ("multigrid: the Cholesky factor would store ..."), for reports.
+  std::string choice;
   StageTimes times;  // assembly, analysis, factorization
 
   bool ready() const { return solver && (system.n_unknowns() == 0 || solver->ready()); }

@@ -7,6 +7,7 @@ namespace pfv {
 void CholeskySolver::setup(const PressureSystem& system, const FactorOptions& options) {
   refinement_.reset();
   factor_.set_openmp_teams(options.openmp_teams);
+  factor_.set_max_entries(options.max_entries);
   factor_.factorize(system, options.ordering, options.precision, options.given, options.min_scaled_entries);
 }
 

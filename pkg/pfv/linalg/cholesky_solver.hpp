@@ -3,6 +3,7 @@
 // iterative refinement in double (refinement.hpp), promoted to a double factor if G turns out
 // too ill-conditioned for it.
 #pragma once
+#include <limits>
 #include <vector>
 
 #include "pfv/linalg/cholmod_solver.hpp"
@@ -17,11 +18,14 @@ struct FactorOptions {
   GivenOrdering given;
   double min_scaled_entries = 0;  // a 32-bit factor only from this many stored entries
   bool openmp_teams = false;      // EngineSettings::cholmod_openmp_teams
+  // setup() throws FactorTooLarge, having spent only the analysis, beyond this many values.
+  double max_entries = std::numeric_limits<double>::infinity();
 };
 
 class CholeskySolver final : public PressureSolver {
  public:
-  // Throws std::domain_error if G is not positive definite.
+  // Throws std::domain_error if G is not positive definite, FactorTooLarge (cholmod_solver.hpp)
+  // beyond options.max_entries.
   void setup(const PressureSystem& system, const FactorOptions& options);
   SolverKind kind() const override { return SolverKind::kCholesky; }
   bool ready() const override { return factor_.ready(); }

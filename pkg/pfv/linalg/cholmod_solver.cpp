@@ -146,6 +146,11 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
   }
   analysis_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!f) throw std::runtime_error("CHOLMOD analysis failed (status " + std::to_string(c->status) + ")");
+  if (static_cast<double>(f->xsize) > max_entries_) {
+    const double stored = static_cast<double>(f->xsize);
+    cholmod_free_factor(&f, c);
+    throw FactorTooLarge(stored, max_entries_);
+  }
   factor_ = f;
   if (!ordering_given_)
     metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
@@ -153,6 +158,11 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
   numeric_factorization(s);
   plan_substitution(s, precision == FactorPrecision::kScaled32 ? min_scaled_entries : kNever);
 }
+
+FactorTooLarge::FactorTooLarge(double stored, double limit)
+    : std::runtime_error("the Cholesky factor would store " + std::to_string(stored) + " values, more than " +
+                         std::to_string(limit)),
+      entries(stored) {}
 
 void CholmodSolver::FreeValues::operator()(double* p) const { std::free(p); }
 

@@ -4,6 +4,7 @@
 #pragma once
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "pfv/linalg/parallel_substitution.hpp"
@@ -45,6 +46,13 @@ struct GivenOrdering {
   bool from_metis = false;  // where the order it descends from came from (for metis_used)
 };
 
+// Thrown by CholmodSolver::factorize when the analysed factor would store more values than
+// allowed (set_max_entries): the solver is then as after release(), and no value was touched.
+struct FactorTooLarge : std::runtime_error {
+  FactorTooLarge(double stored, double limit);
+  double entries;  // values the supernodal factor would store
+};
+
 class CholmodSolver {
  public:
   CholmodSolver();
@@ -68,6 +76,9 @@ class CholmodSolver {
   void solve(const std::vector<double>& rhs, std::vector<double>& x);
   // See EngineSettings::cholmod_openmp_teams; applies to the factorisations that follow.
   void set_openmp_teams(bool on) { openmp_teams_ = on; }
+  // A factorize() whose analysis projects more stored values than this throws FactorTooLarge
+  // before the numeric factorisation (the analysis' cost is all that is spent).
+  void set_max_entries(double entries) { max_entries_ = entries; }
   // The same on the calling thread only (the same arithmetic, the same result).
   void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
   bool reduced_precision() const { return !scale_.empty(); }  // the kScaled32 format
@@ -104,6 +115,7 @@ class CholmodSolver {
   struct Common;
   Common* common_;
   bool openmp_teams_ = false;
+  double max_entries_ = kNever;
   void* factor_ = nullptr;  // cholmod_factor*
   // The factor's numeric values, lent to CHOLMOD (which otherwise allocates them afresh at
   // every factorisation). A factor of tens of thousands of spheres takes hundreds of MB;

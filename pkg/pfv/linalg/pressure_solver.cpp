@@ -10,6 +10,10 @@ std::string_view to_string(SolverKind kind) {
       return "conjugate_gradient";
     case SolverKind::kCholesky:
       return "cholesky";
+    case SolverKind::kMultigrid:
+      return "multigrid";
+    case SolverKind::kAuto:
+      return "auto";
   }
   return "unknown";
 }

@@ -1,6 +1,9 @@
-// One interface for the three ways of solving G p = b over the unknown cells: Gauss-Seidel
-// (YADE's useSolver=0), conjugate gradients with an incomplete Cholesky preconditioner (a PFV
-// extension, useSolver=1) and the sparse Cholesky factor (useSolver=3, the default).
+// One interface for the ways of solving G p = b over the unknown cells: Gauss-Seidel (YADE's
+// useSolver=0), conjugate gradients with an incomplete Cholesky preconditioner (a PFV
+// extension, useSolver=1), the sparse Cholesky factor (useSolver=3) and conjugate gradients
+// with an algebraic multigrid preconditioner (a PFV extension, amg_solver.hpp). kAuto, the
+// default, is the Cholesky factor unless it would not fit in memory or would cost more per
+// step than multigrid (linear_system.hpp); it names a choice, never a solver.
 //
 // A solver is prepared once per system (setup: a factorisation, a preconditioner, nothing)
 // and then solves many right-hand sides: one per DEM step between two remeshes.
@@ -13,23 +16,24 @@ namespace pfv {
 
 struct PressureSystem;
 
-enum class SolverKind { kGaussSeidel, kConjugateGradient, kCholesky };
+enum class SolverKind { kGaussSeidel, kConjugateGradient, kCholesky, kMultigrid, kAuto };
 
 std::string_view to_string(SolverKind kind);
 
 // Stopping rules; each solver reads the ones that concern it.
 struct SolveControl {
-  double tolerance = 1e-6;  // iterative solvers: Gauss-Seidel's max|dp|/max|p|, CG's |r|/|b|
+  double tolerance = 1e-6;  // Gauss-Seidel's max|dp|/max|p|, incomplete-Cholesky CG's |r|/|b|
   double relax = 1.9;       // Gauss-Seidel over-relaxation
   int max_iterations = 200000;
-  double refinement_tolerance = 1e-10;  // refinement with a 32-bit factor, relative to the spread of p
+  // Refinement with a 32-bit factor and multigrid CG: estimated error relative to the spread of p.
+  double refinement_tolerance = 1e-10;
   int max_refinement_passes = 8;
 };
 
 // What the last solve did, each count named for what it counts.
 struct SolveStats {
   int sweeps = 0;             // Gauss-Seidel sweeps over the unknowns
-  int cg_iterations = 0;      // conjugate-gradient iterations
+  int cg_iterations = 0;      // conjugate-gradient iterations (either preconditioner)
   int refinement_passes = 0;  // refinement passes with a 32-bit factor (0 with a double factor)
   bool converged = true;      // false: an iterative solver stopped at max_iterations
 };

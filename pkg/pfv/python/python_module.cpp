@@ -177,11 +177,20 @@ PYBIND11_MODULE(_core, m) {
                     exclusive([](const SharedEngine& e) { return std::string(to_string(e.settings.solver)); }),
                     exclusive([](SharedEngine& e, const std::string& v) {
                       const SolverKind kinds[] = {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient,
-                                                  SolverKind::kCholesky};
+                                                  SolverKind::kCholesky, SolverKind::kMultigrid, SolverKind::kAuto};
                       for (SolverKind k : kinds)
                         if (v == to_string(k)) return update(e, [&](EngineSettings& s) { s.solver = k; });
-                      throw py::value_error("solver must be one of gauss_seidel, conjugate_gradient, cholesky");
-                    }))
+                      throw py::value_error(
+                          "solver must be one of gauss_seidel, conjugate_gradient, cholesky, "
+                          "multigrid, auto; got '" +
+                          v + "'");
+                    }),
+                    "auto (default): the Cholesky factor unless it would exceed max_factor_bytes, then multigrid.")
+      .def_property("max_factor_bytes", get_setting(&EngineSettings::max_factor_bytes),
+                    set_setting(&EngineSettings::max_factor_bytes),
+                    "The largest Cholesky factor solver='auto' accepts (0: half the available memory).")
+      .def_property_readonly("solver_choice", exclusive([](const SharedEngine& e) { return e.solver_choice(); }),
+                             "The current system's solver and why; empty before the first step.")
       .def_property("tolerance", get_setting(&EngineSettings::tolerance), set_setting(&EngineSettings::tolerance))
       .def_property("relax", get_setting(&EngineSettings::relax), set_setting(&EngineSettings::relax))
       .def_property("max_iterations", get_setting(&EngineSettings::max_iterations),

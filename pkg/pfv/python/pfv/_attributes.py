@@ -48,11 +48,15 @@ CORE_NAME: dict[str, str] = {
     "refinement_tolerance": "refinement_tolerance",
     "fluid_density": "fluid_density",
     "yade_wall_throat_factor": "yade_wall_throat_factor",
+    "solver": "solver",
+    "max_factor_bytes": "max_factor_bytes",
 }
 
 # YADE's useSolver numbers and the core's solver names (YADE's 2, Taucs, has no counterpart).
 _SOLVER_OF_USE_SOLVER: dict[int, str] = {0: "gauss_seidel", 1: "conjugate_gradient", 3: "cholesky"}
-_USE_SOLVER_OF: dict[str, int] = {v: k for k, v in _SOLVER_OF_USE_SOLVER.items()}
+# solver="auto" (the default) reads as 3: it is CHOLMOD unless the factor would not fit. The
+# multigrid solver has no YADE number (YADE's 4 is its GPU CHOLMOD) and reads as -1.
+_USE_SOLVER_OF: dict[str, int] = {**{v: k for k, v in _SOLVER_OF_USE_SOLVER.items()}, "auto": 3, "multigrid": -1}
 
 
 def is_yade_attribute(name: str) -> bool:

@@ -229,7 +229,8 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
 
     @property
     def useSolver(self) -> int:
-        """YADE's solver number: 0 Gauss-Seidel, 1 conjugate gradients (PFV), 3 CHOLMOD."""
+        """YADE's solver number: 0 Gauss-Seidel, 1 conjugate gradients (PFV), 3 CHOLMOD (also for
+        solver='auto'), -1 for solver='multigrid', which YADE lacks."""
         return attributes.use_solver_of(self._core.solver)
 
     @useSolver.setter

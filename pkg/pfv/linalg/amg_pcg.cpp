@@ -1,0 +1,297 @@
+#include "pfv/linalg/amg_pcg.hpp"
+
+#include <HYPRE.h>
+#include <HYPRE_parcsr_ls.h>
+#include <_hypre_parcsr_ls.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+namespace pfv {
+namespace {
+
+void check(HYPRE_Int status, const char* what) {
+  if (status != 0) {
+    HYPRE_ClearAllErrors();
+    throw std::runtime_error(std::string("hypre: ") + what + " failed (error code " + std::to_string(status) + ")");
+  }
+}
+
+struct MatrixDeleter {
+  void operator()(HYPRE_IJMatrix m) const { HYPRE_IJMatrixDestroy(m); }
+};
+struct VectorDeleter {
+  void operator()(HYPRE_IJVector v) const { HYPRE_IJVectorDestroy(v); }
+};
+struct SolverDeleter {
+  void operator()(HYPRE_Solver s) const { HYPRE_BoomerAMGDestroy(s); }
+};
+using MatrixHandle = std::unique_ptr<std::remove_pointer_t<HYPRE_IJMatrix>, MatrixDeleter>;
+using VectorHandle = std::unique_ptr<std::remove_pointer_t<HYPRE_IJVector>, VectorDeleter>;
+using SolverHandle = std::unique_ptr<std::remove_pointer_t<HYPRE_Solver>, SolverDeleter>;
+
+// A vector over this process's rows, in hypre's format so that the matrix and the V-cycle read
+// it in place; the iteration works on its local values directly.
+struct WorkVector {
+  VectorHandle ij;
+  HYPRE_ParVector par = nullptr;
+  double* data = nullptr;
+  int n = 0;
+
+  WorkVector(MPI_Comm comm, int first, int count) : n(count) {
+    HYPRE_IJVector v = nullptr;
+    check(HYPRE_IJVectorCreate(comm, first, first + count - 1, &v), "IJVectorCreate");
+    ij.reset(v);
+    check(HYPRE_IJVectorSetObjectType(v, HYPRE_PARCSR), "IJVectorSetObjectType");
+    check(HYPRE_IJVectorInitialize(v), "IJVectorInitialize");
+    check(HYPRE_IJVectorAssemble(v), "IJVectorAssemble");
+    void* object = nullptr;
+    check(HYPRE_IJVectorGetObject(v, &object), "IJVectorGetObject");
+    par = static_cast<HYPRE_ParVector>(object);
+    data = hypre_VectorData(hypre_ParVectorLocalVector(par));
+    std::fill(data, data + n, 0.0);
+  }
+  double* begin() const { return data; }
+  double* end() const { return data + n; }
+};
+
+double global_max(MPI_Comm comm, double local) {
+  double g = local;
+  MPI_Allreduce(&local, &g, 1, MPI_DOUBLE, MPI_MAX, comm);
+  return g;
+}
+
+double dot(HYPRE_ParVector a, HYPRE_ParVector b) {
+  double d = 0;
+  HYPRE_ParVectorInnerProd(a, b, &d);
+  return d;
+}
+
+}  // namespace
+
+void ensure_hypre_initialized() {
+  int running = 0;
+  MPI_Initialized(&running);
+  if (!running) {
+    int provided = 0;
+    // Threads other than the caller's never call MPI here (OpenMP loops only touch memory).
+    if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
+      throw std::runtime_error("MPI could not be initialised for the multigrid solver");
+  }
+  // hypre's own set-up, once per process (it holds no per-solver state).
+  static std::once_flag once;
+  std::call_once(once, [] { HYPRE_Init(); });
+}
+
+struct AmgPcg::Impl {
+  MPI_Comm comm;
+  int first = 0, n = 0;
+  MatrixHandle ij;
+  HYPRE_ParCSRMatrix a = nullptr;
+  SolverHandle amg;
+  // b, x and the iteration's residual, preconditioned residual, direction and G times it.
+  mutable WorkVector b, x, r, z, p, q;
+
+  Impl(MPI_Comm c, int first_row, int count)
+      : comm(c),
+        first(first_row),
+        n(count),
+        b(c, first_row, count),
+        x(c, first_row, count),
+        r(c, first_row, count),
+        z(c, first_row, count),
+        p(c, first_row, count),
+        q(c, first_row, count) {}
+
+  void precondition() const {  // z = M^-1 r: one V-cycle from zero
+    std::fill(z.begin(), z.end(), 0.0);
+    HYPRE_BoomerAMGSolve(amg.get(), a, r.par, z.par);
+  }
+  void residual() const {  // r = b - G x
+    std::copy(b.begin(), b.end(), r.begin());
+    HYPRE_ParCSRMatrixMatvec(-1.0, a, x.par, 1.0, r.par);
+  }
+  double residual_ratio() const {
+    residual();
+    const double bb = dot(b.par, b.par);
+    return bb > 0 ? std::sqrt(dot(r.par, r.par) / bb) : std::sqrt(dot(r.par, r.par));
+  }
+
+  // The preconditioned CG iteration from x; `stop(k, alpha)` after each update of x.
+  template <class Stop>
+  int iterate(int max_iterations, Stop stop) const {
+    residual();
+    precondition();
+    std::copy(z.begin(), z.end(), p.begin());
+    double rz = dot(r.par, z.par);
+    for (int k = 1; k <= max_iterations; ++k) {
+      if (rz <= 0) return k - 1;  // r = 0: x is the solution
+      HYPRE_ParCSRMatrixMatvec(1.0, a, p.par, 0.0, q.par);
+      const double pq = dot(p.par, q.par);
+      if (!(pq > 0))
+        throw std::domain_error(
+            "the multigrid-preconditioned CG met a direction of non-positive "
+            "curvature: the system is not positive definite");
+      const double alpha = rz / pq;
+      for (int i = 0; i < n; ++i) {
+        x.data[i] += alpha * p.data[i];
+        r.data[i] -= alpha * q.data[i];
+      }
+      if (stop(k, alpha)) return k;
+      precondition();
+      const double next = dot(r.par, z.par);
+      const double beta = next / rz;
+      rz = next;
+      for (int i = 0; i < n; ++i) p.data[i] = z.data[i] + beta * p.data[i];
+    }
+    return -1;
+  }
+};
+
+AmgPcg::AmgPcg(MPI_Comm comm, const DistributedRows& rows, const AmgParameters& parameters) {
+  const int n = rows.n_local();
+  if (n <= 0) throw std::invalid_argument("the multigrid solver needs at least one row per process");
+  if (rows.column.size() != rows.value.size() || rows.row_start.front() != 0 ||
+      rows.row_start.back() != static_cast<int>(rows.column.size()))
+    throw std::invalid_argument("the rows given to the multigrid solver are inconsistent");
+  for (int c : rows.column)
+    if (c < 0 || c >= rows.global_rows) throw std::invalid_argument("a column index is outside the matrix");
+  ensure_hypre_initialized();
+  impl_ = std::make_unique<Impl>(comm, rows.first_row, n);
+  Impl& m = *impl_;
+
+  HYPRE_IJMatrix ij = nullptr;
+  const int last = rows.first_row + n - 1;
+  check(HYPRE_IJMatrixCreate(comm, rows.first_row, last, rows.first_row, last, &ij), "IJMatrixCreate");
+  m.ij.reset(ij);
+  check(HYPRE_IJMatrixSetObjectType(ij, HYPRE_PARCSR), "IJMatrixSetObjectType");
+  // Exact per-row sizes split into this process's columns (diag) and the others' (offd), so
+  // that hypre allocates once.
+  std::vector<HYPRE_Int> diag(n, 0), offd(n, 0), count(n), index(n);
+  for (int i = 0; i < n; ++i) {
+    count[i] = rows.row_start[i + 1] - rows.row_start[i];
+    index[i] = rows.first_row + i;
+    for (int e = rows.row_start[i]; e < rows.row_start[i + 1]; ++e)
+      ++(rows.column[e] >= rows.first_row && rows.column[e] <= last ? diag[i] : offd[i]);
+  }
+  check(HYPRE_IJMatrixSetDiagOffdSizes(ij, diag.data(), offd.data()), "IJMatrixSetDiagOffdSizes");
+  check(HYPRE_IJMatrixInitialize(ij), "IJMatrixInitialize");
+  check(HYPRE_IJMatrixSetValues(ij, n, count.data(), index.data(), rows.column.data(), rows.value.data()),
+        "IJMatrixSetValues");
+  check(HYPRE_IJMatrixAssemble(ij), "IJMatrixAssemble");
+  void* object = nullptr;
+  check(HYPRE_IJMatrixGetObject(ij, &object), "IJMatrixGetObject");
+  m.a = static_cast<HYPRE_ParCSRMatrix>(object);
+
+  HYPRE_Solver amg = nullptr;
+  check(HYPRE_BoomerAMGCreate(&amg), "BoomerAMGCreate");
+  m.amg.reset(amg);
+  HYPRE_BoomerAMGSetPrintLevel(amg, 0);
+  HYPRE_BoomerAMGSetMaxIter(amg, 1);  // one V-cycle per application: a preconditioner
+  HYPRE_BoomerAMGSetTol(amg, 0.0);
+  HYPRE_BoomerAMGSetStrongThreshold(amg, parameters.strong_threshold);
+  HYPRE_BoomerAMGSetCoarsenType(amg, parameters.coarsen_type);
+  HYPRE_BoomerAMGSetInterpType(amg, parameters.interp_type);
+  HYPRE_BoomerAMGSetPMaxElmts(amg, parameters.max_row_entries);
+  HYPRE_BoomerAMGSetRelaxType(amg, parameters.relax_type);
+  HYPRE_BoomerAMGSetNumSweeps(amg, 1);
+  HYPRE_BoomerAMGSetAggNumLevels(amg, parameters.aggressive_levels);
+  check(HYPRE_BoomerAMGSetup(amg, m.a, m.b.par, m.x.par), "BoomerAMGSetup");
+
+  // Sizes of the hierarchy, from hypre's own data (its levels' matrices and interpolations).
+  auto* data = reinterpret_cast<hypre_ParAMGData*>(amg);
+  const int levels = hypre_ParAMGDataNumLevels(data);
+  hypre_ParCSRMatrix** a_levels = hypre_ParAMGDataAArray(data);
+  hypre_ParCSRMatrix** p_levels = hypre_ParAMGDataPArray(data);
+  double entries_g = 0, entries_a = 0, entries_all = 0, rows_all = 0;
+  for (int l = 0; l < levels; ++l) {
+    hypre_ParCSRMatrixSetNumNonzeros(a_levels[l]);
+    const double e = static_cast<double>(hypre_ParCSRMatrixNumNonzeros(a_levels[l]));
+    if (l == 0) entries_g = e;
+    entries_a += e;
+    entries_all += e;
+    rows_all += static_cast<double>(hypre_ParCSRMatrixGlobalNumRows(a_levels[l]));
+    if (l + 1 < levels && p_levels && p_levels[l]) {
+      hypre_ParCSRMatrixSetNumNonzeros(p_levels[l]);
+      entries_all += static_cast<double>(hypre_ParCSRMatrixNumNonzeros(p_levels[l]));
+    }
+  }
+  operator_complexity_ = entries_g > 0 ? entries_a / entries_g : 0;
+  // Entries take a value and a column index; rows a start, and per level a few work vectors.
+  bytes_ = entries_all * (sizeof(double) + sizeof(HYPRE_Int)) + rows_all * (sizeof(HYPRE_Int) + 4 * sizeof(double)) +
+           6.0 * n * sizeof(double);
+  bytes_ = global_max(comm, bytes_);  // each process's share is alike; report the largest
+}
+
+AmgPcg::~AmgPcg() = default;
+
+int AmgPcg::levels() const { return hypre_ParAMGDataNumLevels(reinterpret_cast<hypre_ParAMGData*>(impl_->amg.get())); }
+
+AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x, double tolerance,
+                            int max_iterations) {
+  Impl& m = *impl_;
+  if (static_cast<int>(b.size()) != m.n || static_cast<int>(x.size()) != m.n)
+    throw std::invalid_argument("the multigrid solve needs one value of b and x per local row");
+  std::copy(b.begin(), b.end(), m.b.begin());
+  std::copy(x.begin(), x.end(), m.x.begin());
+  constexpr double kFirstIterationMargin = 1e-3;
+  double previous = 0, ratio = 0, last_ratio = 0;
+  const auto stop = [&](int k, double alpha) {
+    double d = 0, lo = m.x.data[0], hi = m.x.data[0], size = 0;
+    for (int i = 0; i < m.n; ++i) {
+      d = std::max(d, std::abs(alpha * m.p.data[i]));
+      lo = std::min(lo, m.x.data[i]);
+      hi = std::max(hi, m.x.data[i]);
+      size = std::max(size, std::abs(m.x.data[i]));
+    }
+    // One reduction for the three maxima: the update, -min x and max x (and max |x|).
+    double local[4] = {d, -lo, hi, size}, global[4];
+    MPI_Allreduce(local, global, 4, MPI_DOUBLE, MPI_MAX, m.comm);
+    d = global[0];
+    const double spread = global[1] + global[2] > 0 ? global[1] + global[2] : global[3];
+    const double bound = tolerance * spread;
+    if (d == 0) return true;
+    if (k == 1) {
+      previous = d;
+      return d <= kFirstIterationMargin * bound;
+    }
+    last_ratio = ratio;
+    ratio = d / previous;
+    previous = d;
+    const double rho = std::max(ratio, last_ratio);
+    return rho < 1 && rho / (1 - rho) * d <= bound;
+  };
+  AmgSolveStats stats;
+  const int k = m.iterate(max_iterations, stop);
+  stats.converged = k >= 0;
+  stats.iterations = k >= 0 ? k : max_iterations;
+  std::copy(m.x.begin(), m.x.end(), x.begin());
+  stats.relative_residual = m.residual_ratio();
+  return stats;
+}
+
+AmgSolveStats AmgPcg::solve_to_residual(const std::vector<double>& b, std::vector<double>& x, double relative_residual,
+                                        int max_iterations) const {
+  const Impl& m = *impl_;
+  if (static_cast<int>(b.size()) != m.n || static_cast<int>(x.size()) != m.n)
+    throw std::invalid_argument("the multigrid solve needs one value of b and x per local row");
+  std::copy(b.begin(), b.end(), m.b.begin());
+  std::copy(x.begin(), x.end(), m.x.begin());
+  const double target = relative_residual * std::sqrt(dot(m.b.par, m.b.par));
+  const auto stop = [&](int, double) { return std::sqrt(dot(m.r.par, m.r.par)) <= target; };
+  AmgSolveStats stats;
+  const int k = target > 0 ? m.iterate(max_iterations, stop) : 0;
+  if (target == 0) std::fill(m.x.begin(), m.x.end(), 0.0);
+  stats.converged = k >= 0;
+  stats.iterations = k >= 0 ? k : max_iterations;
+  std::copy(m.x.begin(), m.x.end(), x.begin());
+  stats.relative_residual = m.residual_ratio();
+  return stats;
+}
+
+}  // namespace pfv

@@ -1,0 +1,88 @@
+// Conjugate gradients on G preconditioned by one V-cycle of algebraic multigrid (hypre's
+// BoomerAMG), over the rows of G one MPI process owns: a pressure solve whose memory grows as
+// O(N), where the Cholesky factor grows as N^(4/3) on a three-dimensional pore network.
+//
+// The hierarchy is built once per system (at a remesh) and reused by every solve. The
+// iteration is written here, not taken from hypre's PCG, for its stopping rule: the engine's
+// pressures are accurate relative to their spread (max p - min p), as the refinement of a
+// 32-bit factor is (refinement.hpp), and hypre's Krylov solvers stop on residual norms only.
+// A solve stops once the estimated error rho / (1 - rho) * max |update| is below
+// tolerance * spread, rho the larger of the last two ratios of successive update norms; the
+// first iteration never stops unless its update is already 1e-3 of that bound.
+//
+// MPI: a system distributed over the processes of a communicator (each owns a contiguous range
+// of rows, with global column indices) is solved by the same code as a local one on
+// MPI_COMM_SELF. The engine solves locally; bench/amg/ solves a saved system over two processes.
+#pragma once
+#include <mpi.h>
+
+#include <memory>
+#include <vector>
+
+namespace pfv {
+
+// Rows first_row .. first_row + n - 1 of a symmetric positive definite matrix, full rows
+// (both triangles) compressed by row, with global column indices.
+struct DistributedRows {
+  long long global_rows = 0;
+  int first_row = 0;
+  std::vector<int> row_start;  // n + 1 entries
+  std::vector<int> column;
+  std::vector<double> value;
+
+  int n_local() const { return row_start.empty() ? 0 : static_cast<int>(row_start.size()) - 1; }
+};
+
+// BoomerAMG's settings for a three-dimensional scalar diffusion operator (hypre's manual,
+// "BoomerAMG": HMIS coarsening with extended+i interpolation truncated to a few entries per row,
+// a strength threshold of 0.5 in 3D), with a symmetric smoother so that the V-cycle is a
+// symmetric preconditioner for CG.
+struct AmgParameters {
+  double strong_threshold = 0.5;
+  int coarsen_type = 10;  // HMIS
+  int interp_type = 6;    // extended+i
+  int max_row_entries = 4;
+  int relax_type = 8;         // l1-scaled hybrid symmetric Gauss-Seidel
+  int aggressive_levels = 0;  // levels of aggressive coarsening (less memory, more iterations)
+};
+
+struct AmgSolveStats {
+  int iterations = 0;
+  bool converged = false;
+  double relative_residual = 0;  // |b - G x| / |b| on return
+};
+
+// Ensures MPI (a singleton process when not started by mpirun) and hypre are initialised;
+// throws std::runtime_error if MPI cannot start. Finalisation is left to process exit.
+void ensure_hypre_initialized();
+
+class AmgPcg {
+ public:
+  // Builds the matrix and its multigrid hierarchy; collective over comm. Throws
+  // std::invalid_argument on rows that do not describe a square block of a global matrix,
+  // std::runtime_error if hypre fails.
+  AmgPcg(MPI_Comm comm, const DistributedRows& rows, const AmgParameters& parameters = {});
+  ~AmgPcg();
+  AmgPcg(const AmgPcg&) = delete;
+  AmgPcg& operator=(const AmgPcg&) = delete;
+
+  // x (this process's rows) holds the start and returns the solution; stops by the spread rule
+  // above. Collective.
+  AmgSolveStats solve(const std::vector<double>& b, std::vector<double>& x, double tolerance, int max_iterations);
+  // Stops at |b - G x| <= relative_residual |b| instead; x = 0 on entry gives G^-1 b.
+  AmgSolveStats solve_to_residual(const std::vector<double>& b, std::vector<double>& x, double relative_residual,
+                                  int max_iterations) const;
+
+  int levels() const;
+  // Entries of all levels' matrices over those of G (hypre's operator complexity).
+  double operator_complexity() const { return operator_complexity_; }
+  // Bytes held by the hierarchy, the matrix and the work vectors (an estimate from their entries).
+  double bytes() const { return bytes_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  double operator_complexity_ = 0, bytes_ = 0;
+};
+
+}  // namespace pfv

@@ -1,0 +1,137 @@
+// The multigrid-preconditioned CG (amg_pcg.hpp) gives the direct solve's pressures within its
+// stopping rule's tolerance of the pressure spread, at 10 000 and 50 000 spheres, over moving
+// steps; solver=auto picks it when the factor exceeds its budget and says so.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "pfv/engine/flow_engine.hpp"
+#include "pfv/linalg/amg_solver.hpp"
+#include "pfv/model/pressure_system.hpp"
+#include "test_packings.hpp"
+
+using namespace pfv;
+
+namespace {
+
+// m^3 spheres on a jittered cubic lattice filling the unit cube (a packing of any size in O(N)).
+test::TestPacking jittered_lattice(int m, unsigned seed) {
+  test::TestPacking p;
+  p.walls.coord = {0, 1, 0, 1, 0, 1};
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double h = 1.0 / m;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j)
+      for (int k = 0; k < m; ++k) {
+        p.centre.emplace_back((i + 0.5 + 0.08 * u(gen)) * h, (j + 0.5 + 0.08 * u(gen)) * h,
+                              (k + 0.5 + 0.08 * u(gen)) * h);
+        p.radius.push_back((0.36 + 0.04 * u(gen)) * h);
+      }
+  return p;
+}
+
+double spread(const std::vector<double>& p) {
+  const auto [lo, hi] = std::minmax_element(p.begin(), p.end());
+  return *hi - *lo;
+}
+
+// Runs the same squeezed permeameter with the direct and the multigrid solver and checks every
+// step's pressures against each other.
+void expect_multigrid_matches_direct(const test::TestPacking& p, int steps) {
+  FlowEngine direct = test::permeameter(1), multigrid = test::permeameter(1);
+  direct.settings.solver = SolverKind::kCholesky;
+  direct.settings.mixed_precision = false;  // the reference: a double factor
+  multigrid.settings.solver = SolverKind::kMultigrid;
+  std::vector<Vec3> x = p.centre;
+  const double dt = 1e-3;
+  for (int step = 0; step < steps; ++step) {
+    for (std::size_t k = 0; k < x.size(); ++k)  // a slow squeeze along y: dV/dt != 0
+      x[k].y() = 0.5 + (p.centre[k].y() - 0.5) * (1 - 2e-4 * step * (1 + 0.1 * step));
+    direct.step(x, p.radius, p.walls, dt);
+    multigrid.step(x, p.radius, p.walls, dt);
+    ASSERT_EQ(multigrid.pressure_solver()->kind(), SolverKind::kMultigrid);
+    ASSERT_TRUE(multigrid.last_solve().converged) << "step " << step;
+    EXPECT_GT(multigrid.last_solve().cg_iterations, 0);
+    const std::vector<double>& ref = direct.pressure();
+    const double s = spread(ref);
+    ASSERT_GT(s, 0);
+    double worst = 0;
+    for (std::size_t c = 0; c < ref.size(); ++c) worst = std::max(worst, std::abs(multigrid.pressure()[c] - ref[c]));
+    // The stopping rule's promise: refinement_tolerance of the spread (its error is estimated
+    // from the contraction of the last iterations; the worst seen here is 0.92 of it).
+    EXPECT_LE(worst, 2 * multigrid.settings.refinement_tolerance * s) << "step " << step;
+  }
+}
+
+}  // namespace
+
+TEST(Multigrid, FullRowsAreTheSymmetricMatrix) {
+  const auto p = test::random_packing(300, 5, 0.03, 0.05);
+  FlowEngine e = test::permeameter(0);
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  const PressureSystem& s = e.system();
+  const DistributedRows rows = full_rows(s);
+  const int n = s.n_unknowns();
+  ASSERT_EQ(rows.n_local(), n);
+  // Every stored upper entry appears at (i, j) and (j, i); nothing else does.
+  std::size_t upper = 0, diagonal = 0;
+  for (int j = 0; j < n; ++j)
+    for (int e2 = s.col_start[j]; e2 < s.col_start[j + 1]; ++e2) (s.row[e2] == j ? diagonal : upper) += 1;
+  EXPECT_EQ(rows.column.size(), diagonal + 2 * upper);
+  const auto entry = [&](int i, int j) {
+    for (int e2 = rows.row_start[i]; e2 < rows.row_start[i + 1]; ++e2)
+      if (rows.column[e2] == j) return rows.value[e2];
+    return 0.0;
+  };
+  for (int i = 0; i < n; ++i)
+    for (int e2 = rows.row_start[i]; e2 < rows.row_start[i + 1]; ++e2)
+      EXPECT_EQ(rows.value[e2], entry(rows.column[e2], i)) << i << " " << rows.column[e2];
+}
+
+TEST(Multigrid, MatchesTheDirectSolveAt10kSpheres) { expect_multigrid_matches_direct(jittered_lattice(22, 3), 4); }
+
+TEST(Multigrid, MatchesTheDirectSolveAt50kSpheres) { expect_multigrid_matches_direct(jittered_lattice(37, 4), 3); }
+
+TEST(Multigrid, SolveToResidualIsTheInverse) {
+  const auto p = jittered_lattice(10, 8);
+  FlowEngine e = test::permeameter(2);
+  e.settings.solver = SolverKind::kCholesky;
+  e.settings.mixed_precision = false;
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  const PressureSystem& s = e.system();
+  AmgSolver amg;
+  amg.setup(s);
+  std::vector<double> b(s.n_unknowns()), x, y;
+  for (int i = 0; i < s.n_unknowns(); ++i) b[i] = std::sin(0.3 * i);
+  amg.apply_inverse(s, b, x, {});
+  e.pressure_solver()->apply_inverse(s, b, y, {});
+  const double scale =
+      *std::max_element(y.begin(), y.end(), [](double a, double c) { return std::abs(a) < std::abs(c); });
+  for (int i = 0; i < s.n_unknowns(); ++i) EXPECT_NEAR(x[i], y[i], 1e-7 * std::abs(scale));
+  EXPECT_GT(amg.hierarchy()->levels(), 1);
+  EXPECT_GT(amg.hierarchy()->operator_complexity(), 1);
+}
+
+TEST(Multigrid, AutoTakesTheFactorUnlessItExceedsTheBudget) {
+  const auto p = jittered_lattice(12, 9);
+  FlowEngine roomy = test::permeameter(0), tight = test::permeameter(0);
+  ASSERT_EQ(roomy.settings.solver, SolverKind::kAuto);  // the default
+  tight.settings.max_factor_bytes = 1e4;                // far below this factor
+  roomy.step(p.centre, p.radius, p.walls, 1e-3);
+  tight.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(roomy.pressure_solver()->kind(), SolverKind::kCholesky);
+  EXPECT_EQ(roomy.solver_choice().rfind("cholesky:", 0), 0u) << roomy.solver_choice();
+  EXPECT_EQ(tight.pressure_solver()->kind(), SolverKind::kMultigrid);
+  EXPECT_EQ(tight.solver_choice().rfind("multigrid: the Cholesky factor would store", 0), 0u) << tight.solver_choice();
+  const double s = spread(roomy.pressure());
+  for (std::size_t c = 0; c < roomy.pressure().size(); ++c)
+    EXPECT_NEAR(tight.pressure()[c], roomy.pressure()[c], 2 * tight.settings.refinement_tolerance * s);
+  // A later remesh keeps the choice without another analysis.
+  tight.request_remesh();
+  tight.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(tight.pressure_solver()->kind(), SolverKind::kMultigrid);
+  EXPECT_EQ(tight.solver_choice(), "multigrid: kept from the previous mesh");
+}

@@ -96,7 +96,10 @@ double factor_entry_budget(const EngineSettings& s, const PressureSolver* recycl
 
 std::string bytes_text(double bytes) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.3g GB", bytes / 1e9);
+  if (bytes >= 1e9)
+    std::snprintf(text, sizeof text, "%.3g GB", bytes / 1e9);
+  else
+    std::snprintf(text, sizeof text, "%.3g MB", bytes / 1e6);
   return text;
 }
 

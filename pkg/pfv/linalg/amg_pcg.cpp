@@ -239,8 +239,8 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
     throw std::invalid_argument("the multigrid solve needs one value of b and x per local row");
   std::copy(b.begin(), b.end(), m.b.begin());
   std::copy(x.begin(), x.end(), m.x.begin());
-  constexpr double kFirstIterationMargin = 1e-3;
-  double previous = 0, ratio = 0, last_ratio = 0;
+  constexpr double kFirstIterationMargin = 1e-3, kSeedSafety = 2;
+  double previous = 0, ratio = 0, last_ratio = 0, largest = 0;
   const auto stop = [&](int k, double alpha) {
     double d = 0, lo = m.x.data[0], hi = m.x.data[0], size = 0;
     for (int i = 0; i < m.n; ++i) {
@@ -258,11 +258,13 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
     if (d == 0) return true;
     if (k == 1) {
       previous = d;
-      return d <= kFirstIterationMargin * bound;
+      const double seed = kSeedSafety * seen_ratio_;
+      return d <= kFirstIterationMargin * bound || (seed > 0 && seed < 1 && seed / (1 - seed) * d <= bound);
     }
     last_ratio = ratio;
     ratio = d / previous;
     previous = d;
+    largest = std::max(largest, ratio);
     const double rho = std::max(ratio, last_ratio);
     return rho < 1 && rho / (1 - rho) * d <= bound;
   };
@@ -270,8 +272,8 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
   const int k = m.iterate(max_iterations, stop);
   stats.converged = k >= 0;
   stats.iterations = k >= 0 ? k : max_iterations;
+  if (stats.iterations >= 2) seen_ratio_ = largest;
   std::copy(m.x.begin(), m.x.end(), x.begin());
-  stats.relative_residual = m.residual_ratio();
   return stats;
 }
 

@@ -7,8 +7,12 @@
 // pressures are accurate relative to their spread (max p - min p), as the refinement of a
 // 32-bit factor is (refinement.hpp), and hypre's Krylov solvers stop on residual norms only.
 // A solve stops once the estimated error rho / (1 - rho) * max |update| is below
-// tolerance * spread, rho the larger of the last two ratios of successive update norms; the
-// first iteration never stops unless its update is already 1e-3 of that bound.
+// tolerance * spread, rho the larger of the last two ratios of successive update norms. The
+// first iteration has no ratio of its own: it takes twice the largest ratio of the last solve
+// that made two or more (as the refinement seeds its contraction), and without one stops only
+// if its update is already 1e-3 of the bound. Between remeshes, once the start is extrapolated
+// from a smooth history, one iteration (one V-cycle, two products with G) is then the common
+// case.
 //
 // MPI: a system distributed over the processes of a communicator (each owns a contiguous range
 // of rows, with global column indices) is solved by the same code as a local one on
@@ -49,7 +53,7 @@ struct AmgParameters {
 struct AmgSolveStats {
   int iterations = 0;
   bool converged = false;
-  double relative_residual = 0;  // |b - G x| / |b| on return
+  double relative_residual = 0;  // |b - G x| / |b| on return (solve_to_residual only)
 };
 
 // Ensures MPI (a singleton process when not started by mpirun) and hypre are initialised;
@@ -83,6 +87,7 @@ class AmgPcg {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   double operator_complexity_ = 0, bytes_ = 0;
+  double seen_ratio_ = 0;  // the largest update ratio of the last solve with two iterations or more
 };
 
 }  // namespace pfv

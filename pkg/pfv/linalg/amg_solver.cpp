@@ -41,7 +41,6 @@ void AmgSolver::setup(const PressureSystem& system, const AmgParameters& paramet
 SolveStats AmgSolver::solve(const PressureSystem&, const std::vector<double>& b, std::vector<double>& x,
                             const SolveControl& control) {
   const AmgSolveStats s = pcg_->solve(b, x, control.refinement_tolerance, control.max_iterations);
-  relative_residual_ = s.relative_residual;
   SolveStats stats;
   stats.cg_iterations = s.iterations;
   stats.converged = s.converged;

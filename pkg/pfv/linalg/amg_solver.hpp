@@ -27,11 +27,9 @@ class AmgSolver final : public PressureSolver {
   void release() override { pcg_.reset(); }
 
   const AmgPcg* hierarchy() const { return pcg_.get(); }
-  double relative_residual() const { return relative_residual_; }  // of the last solve
 
  private:
   std::unique_ptr<AmgPcg> pcg_;
-  double relative_residual_ = 0;
 };
 
 // G's full rows (both triangles) from its stored upper triangle: one process's whole matrix.

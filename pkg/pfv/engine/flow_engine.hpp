@@ -173,6 +173,9 @@ class FlowEngine {
   int field_evaluations() const { return field_evaluations_; }
   double accumulated_strain() const { return strain_; }
   const SolveStats& last_solve() const { return last_solve_; }
+  // The right-hand side and the solution of the last solve, one value per unknown of system().
+  const std::vector<double>& last_rhs() const { return rhs_; }
+  const std::vector<double>& last_solution() const { return solution_; }
   double refinement_contraction() const;  // -1 until measured, or without a 32-bit factor
   const StageTimes& remesh_times() const { return remesh_times_; }
   const StageTimes& step_times() const { return step_times_; }

@@ -6,6 +6,7 @@
 
 #include <vector>
 
+#include "pfv/linalg/system_io.hpp"
 #include "pfv/python/shared_engine.hpp"
 #include "triangulation/pore_geometry.hpp"
 
@@ -34,7 +35,21 @@ void bind_output(EngineClass& engine) {
              return vector_to_array(source);
            }),
            "Pressure source of every cell: wall w (0..5) or 6 + k (imposed pressure k) for a cell whose pressure\n"
-           "is imposed (a Dirichlet cell of the system), -1 for a cell whose pressure is solved for.");
+           "is imposed (a Dirichlet cell of the system), -1 for a cell whose pressure is solved for.")
+      .def("save_system", exclusive([](const SharedEngine& e, const std::string& folder) {
+             const FlowEngine& m = meshed(e);
+             if (m.last_rhs().size() != static_cast<std::size_t>(m.system().n_unknowns()) ||
+                 m.last_solution().size() != m.last_rhs().size())
+               throw py::value_error("no solve on the current system yet (run a step first)");
+             try {
+               write_system(folder, m.system(), m.last_rhs(), m.last_solution());
+             } catch (const std::runtime_error& error) {
+               throw py::value_error(error.what());
+             }
+           }),
+           py::arg("folder"),
+           "Writes the last step's system G p = b into an existing folder: G.mtx (Matrix Market, symmetric),\n"
+           "b.mtx and the solution x.mtx, for a solver run outside the engine (build/pfv_amg_solve, over MPI).");
 }
 
 }  // namespace pfv::python

@@ -3,13 +3,18 @@
 p_top = A(t) (1 + cos(pi x / L)), A(t) = rate t.
 
     yade-double -n -x examples/wave_ramp.py [--quick] [--rate=100] [--duration=20] [--out=DIR]
+    yade-double -n -x examples/wave_ramp.py --from=DIR     (the criterion again on the records in DIR)
 
-Both samples (phi_c1 = 1 and 30 deg; phi_c2 = 30 deg) under the same ramp. The amplitude at which a
-sample becomes unstable is where its kinetic energy first exceeds 100 times its level in the first
-second (the thesis reads it off the KE curve: 1500 Pa dense, about a quarter of that loose); the
-ratio of the two is printed against the thesis' about 4.
+Both samples (phi_c1 = 1 and 30 deg; phi_c2 = 30 deg) under the same ramp. A sample becomes unstable
+at the amplitude where the root-mean-square grain velocity sqrt(2 KE / M) first exceeds 1 % of
+sqrt(g d50), the velocity scale of a grain falling by its own size: grains at rest on a stable bed
+move orders of magnitude slower, a failing bed faster (the thesis reads the instability off the jump of
+its KE curve: 1500 Pa dense, about a quarter of that loose). The amplitudes at 0.5 % and 2 % are
+printed beside it to show how much the threshold matters; the ratio dense / loose is printed against
+the thesis' about 4, and everything is written to DIR/instability.json.
 """
 import json
+import math
 import os
 import sys
 
@@ -18,23 +23,64 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: argv[0] is the script
 import seabed_sample  # noqa: E402
 import seabed_wave  # noqa: E402
-from yade import plot  # noqa: E402
-from pfv import waves  # noqa: E402
 
-o = seabed_wave.options(sys.argv[1:], dict(rate=100.0, duration=20.0, out="wave-ramp"))
+THRESHOLDS = (0.005, 0.01, 0.02)  # of sqrt(g d50); 0.01 is the criterion
+CRITERION = 0.01
+
+
+def instability_amplitudes(t, ke, amplitude, mass, d50):
+    """{threshold: amplitude (Pa) where sqrt(2 KE / mass) first exceeds threshold * sqrt(g d50)}, NaN if never."""
+    v = np.sqrt(2 * np.asarray(ke) / mass) / math.sqrt(seabed_sample.GRAVITY * d50)
+    out = {}
+    for f in THRESHOLDS:
+        above = np.flatnonzero(v > f)
+        out[f] = float(np.asarray(amplitude)[above[0]]) if len(above) else float("nan")
+    return out
+
+
+def read_record(folder):
+    """t, KE and A of a timeseries.csv written by seabed_wave.run (plot.saveDataTxt)."""
+    path = os.path.join(folder, "timeseries.csv")
+    with open(path) as f:
+        head = f.readline().lstrip("#").split()
+    data = np.loadtxt(path)
+    col = {h: i for i, h in enumerate(head)}
+    return data[:, col["t"]], data[:, col["KE"]], data[:, col["A"]]
+
+
+def sample_mass(sample):
+    rho = sample["grains"]["density"]
+    return sum(4 / 3 * math.pi * s[3] ** 3 * rho for s in sample["spheres"])
+
+
+o = seabed_wave.options(sys.argv[1:], dict(rate=100.0, duration=20.0, out="wave-ramp", **{"from": ""}))
+folder = o["from"] or o["out"]
 num = 1000 if o["quick"] else 5000
 unstable = {}
 for name, friction in (("dense", 1.0), ("loose", 30.0)):
+    if o["from"]:
+        with open(os.path.join(folder, name, "summary.json")) as f:
+            num = json.load(f)["grains"]
     sample = seabed_sample.prepare(num, friction)
-    load = waves.HalfWave(amplitude=0.0, rate=o["rate"], length=sample["box"][0])
-    seabed_wave.run(f"ramp-{name}", load, sample, o["duration"], os.path.join(o["out"], name), 1.0)
-    t, ke = np.asarray(plot.data["t"]), np.asarray(plot.data["KE"])
-    quiet = np.median(ke[t <= 1.0]) if np.any(t <= 1.0) else ke[0]
-    above = np.flatnonzero((t > 1.0) & (ke > 100 * quiet))
-    unstable[name] = float(load.amplitude_at(t[above[0]])) if len(above) else float("nan")
-    print(f"{name}: unstable at A = {unstable[name]:.0f} Pa")
-ratio = unstable["dense"] / unstable["loose"]
-print(f"instability amplitude dense / loose = {ratio:.2f} (thesis: about 4)")
-with open(os.path.join(o["out"], "instability.json"), "w") as f:
-    json.dump(dict(unstable_amplitude=unstable, ratio=ratio, thesis_ratio=4.0), f, indent=1)
+    if not o["from"]:
+        from yade import plot
+        from pfv import waves
+        load = waves.HalfWave(amplitude=0.0, rate=o["rate"], length=sample["box"][0])
+        seabed_wave.run(f"ramp-{name}", load, sample, o["duration"], os.path.join(folder, name), 1.0)
+        record = plot.data["t"], plot.data["KE"], plot.data["A"]
+    else:
+        record = read_record(os.path.join(folder, name))
+    unstable[name] = instability_amplitudes(*record, sample_mass(sample), sample["grains"]["d50"])
+    print(f"{name} (n = {sample['porosity']:.3f}): unstable at A = {unstable[name][CRITERION]:.0f} Pa "
+          f"(thresholds {', '.join(f'{100 * f:g} %: {a:.0f} Pa' for f, a in unstable[name].items())})")
+ratios = {f: unstable["dense"][f] / unstable["loose"][f] for f in THRESHOLDS}
+print(f"instability amplitude dense / loose = {ratios[CRITERION]:.2f} (thesis: about 4; thresholds "
+      f"{', '.join(f'{100 * f:g} %: {r:.2f}' for f, r in ratios.items())})")
+with open(os.path.join(folder, "instability.json"), "w") as f:
+    json.dump(dict(criterion="rms grain velocity > threshold * sqrt(g d50)", threshold=CRITERION,
+                   unstable_amplitude={k: v[CRITERION] for k, v in unstable.items()},
+                   ratio=ratios[CRITERION], by_threshold={str(t): dict(dense=unstable["dense"][t],
+                                                                       loose=unstable["loose"][t], ratio=ratios[t])
+                                                          for t in THRESHOLDS},
+                   thesis=dict(dense=1500.0, ratio=4.0)), f, indent=1)
 sys.exit(0)

@@ -45,12 +45,15 @@ def options(argv, defaults):
     return o
 
 
-def build(sample):
-    """The bed with its flow engine; returns (flow, box)."""
+def build(sample, settings=None):
+    """The bed with its flow engine (FlowEngine attributes in `settings` set on top of this
+    example's); returns (flow, box)."""
     seabed_sample.load_into_scene(sample)
     L, h, W = sample["box"]
     flow = FlowEngine(label="flow", viscosity=VISCOSITY, fluid_density=RHO_F, meshUpdateInterval=200,
                       bndCondIsPressure=[0, 0, 0, 1, 0, 0], bndCondValue=[0] * 6, boundaryUseMaxMin=[0] * 6)
+    for name, value in (settings or {}).items():
+        setattr(flow, name, value)
     engines = list(O.engines)
     newton = [e for e in engines if isinstance(e, NewtonIntegrator)][0]
     newton.damping = 0.0  # the fluid damps
@@ -64,9 +67,9 @@ def build(sample):
     return flow, (L, h, W)
 
 
-def run(load_name, load, sample, duration, out, period):
+def run(load_name, load, sample, duration, out, period, settings=None):
     """Run the bed under `load` (a pfv.waves profile) for `duration` s and write the outputs."""
-    flow, (L, h, W) = build(sample)
+    flow, (L, h, W) = build(sample, settings)
     flow.set_boundary_pressure(flow.ymax, load)
     n0 = sample["porosity"]
     grid = diagnostics.SensorGrid.in_box((0, 0, 0), (L, h, W), verticals=5, levels=6)
@@ -103,7 +106,8 @@ def run(load_name, load, sample, duration, out, period):
     after = t[window - 1:] >= period
     peak = float(np.max(smooth[after])) if np.any(after) else float("nan")
     summary = dict(load=load_name, profile=repr(load), grains=sample["num"], friction_prep=sample["friction"],
-                   porosity0=n0, i_c=monitor.i_c, duration=duration, dt=O.dt, steps=O.iter, wall_seconds=wall,
+                   settings=settings or {}, porosity0=n0, i_c=monitor.i_c, duration=duration, dt=O.dt, steps=O.iter,
+                   wall_seconds=wall,
                    peak_mean_ratio=peak, liquefied=bool(peak > LIQUEFIED),
                    final_porosity=plot.data["porosity"][-1], settlement=plot.data["top"][0] - plot.data["top"][-1],
                    max_axis_dx=float(np.max(np.abs(dx))) if len(dx) else 0.0)

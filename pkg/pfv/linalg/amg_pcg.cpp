@@ -191,7 +191,7 @@ AmgPcg::AmgPcg(MPI_Comm comm, const DistributedRows& rows, const AmgParameters& 
   HYPRE_Solver amg = nullptr;
   check(HYPRE_BoomerAMGCreate(&amg), "BoomerAMGCreate");
   m.amg.reset(amg);
-  HYPRE_BoomerAMGSetPrintLevel(amg, 0);
+  HYPRE_BoomerAMGSetPrintLevel(amg, parameters.print_level);
   HYPRE_BoomerAMGSetMaxIter(amg, 1);  // one V-cycle per application: a preconditioner
   HYPRE_BoomerAMGSetTol(amg, 0.0);
   HYPRE_BoomerAMGSetStrongThreshold(amg, parameters.strong_threshold);

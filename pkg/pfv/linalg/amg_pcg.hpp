@@ -48,6 +48,7 @@ struct AmgParameters {
   int max_row_entries = 4;
   int relax_type = 8;         // l1-scaled hybrid symmetric Gauss-Seidel
   int aggressive_levels = 0;  // levels of aggressive coarsening (less memory, more iterations)
+  int print_level = 0;        // hypre's report of the hierarchy (1: at set-up, on stdout)
 };
 
 struct AmgSolveStats {

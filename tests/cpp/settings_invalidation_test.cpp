@@ -85,6 +85,7 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
       {"minimum_porosity", [](FlowEngine& e) { e.settings.minimum_porosity = 0.1; }},
       {"flat_threshold", [](FlowEngine& e) { e.settings.flat_threshold = 1e-6; }},
       {"volume_correction", [](FlowEngine& e) { e.settings.volume_correction = 0.5; }},
+      {"shear_viscosity", [](FlowEngine& e) { e.settings.shear_viscosity = 1e-3; }},
       {"interpolate_on_remesh", [](FlowEngine& e) { e.settings.interpolate_on_remesh = true; }},
       {"set_cell_pressure", [](FlowEngine& e) { e.set_cell_pressure(0, 0.5); }},
       {"background_remesh", [](FlowEngine& e) { e.settings.background_remesh = true; }},

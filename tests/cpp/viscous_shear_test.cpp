@@ -302,3 +302,29 @@ TEST(ViscousShear, NonFiniteShearIsRefusedAndTheEngineUnchanged) {
   e.step(x2, p.radius, p.walls, 1.0);
   EXPECT_TRUE(e.shear_forces()[0].allFinite());
 }
+
+TEST(ViscousShear, ShearViscosityScalesTheShearTermOnly) {
+  const auto p = test::random_packing(300, 41);
+  const double dt = 1e-3;
+  std::mt19937 gen(5);
+  std::normal_distribution<double> g;
+  const auto x1 = moved(p.centre, dt, [&](const Vec3&, int) { return Vec3(g(gen), g(gen), g(gen)); });
+  FlowEngine same = shear_engine(), quarter = shear_engine();
+  quarter.settings.shear_viscosity = 0.25 * quarter.settings.conductance.viscosity;
+  for (FlowEngine* e : {&same, &quarter}) {
+    e->step(p.centre, p.radius, p.walls, dt);
+    e->step(x1, p.radius, p.walls, dt);
+  }
+  ASSERT_FALSE(same.shear_forces().empty());
+  ASSERT_GT(norm_sum(same.shear_forces()), 0);
+  for (std::size_t v = 0; v < same.shear_forces().size(); ++v)
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(quarter.shear_forces()[v][a], 0.25 * same.shear_forces()[v][a],
+                  1e-12 * std::abs(same.shear_forces()[v][a]) + 1e-300);
+      // The pressure and drag part F - F_shear is the same in both.
+      const double rest = same.forces()[v][a] - same.shear_forces()[v][a];
+      EXPECT_NEAR(quarter.forces()[v][a] - quarter.shear_forces()[v][a], rest, 1e-12 * (std::abs(rest) + 1));
+    }
+  quarter.settings.shear_viscosity = -1;
+  EXPECT_THROW(quarter.step(x1, p.radius, p.walls, dt), std::invalid_argument);
+}

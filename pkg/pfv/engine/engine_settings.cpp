@@ -35,6 +35,8 @@ void validate(const EngineSettings& s) {
   require(s.solver == SolverKind::kGaussSeidel || s.solver == SolverKind::kConjugateGradient ||
               s.solver == SolverKind::kCholesky || s.solver == SolverKind::kMultigrid || s.solver == SolverKind::kAuto,
           "solver must be Gauss-Seidel, conjugate gradients, Cholesky, multigrid or auto");
+  require(std::isfinite(s.shear_viscosity) && s.shear_viscosity >= 0,
+          named("shear_viscosity", s.shear_viscosity, "finite and >= 0 (0: viscosity)"));
   require(std::isfinite(s.max_factor_bytes) && s.max_factor_bytes >= 0,
           named("max_factor_bytes", s.max_factor_bytes, "finite and >= 0 (0: from the memory available)"));
   // A tolerance of zero never stops Gauss-Seidel and NaN stops conjugate gradients at once.

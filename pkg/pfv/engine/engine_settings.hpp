@@ -72,6 +72,11 @@ struct EngineSettings {
   // Viscous shear between neighbouring spheres (YADE's viscousShear; viscous_shear.hpp). Off:
   // no pair geometry is built or stored and the step does no extra work.
   bool viscous_shear = false;
+  // The viscosity of the shear term when positive (0: viscosity). The thesis (section 6.3.5) adds
+  // shear forces at water's 1e-3 Pa s to a seabed whose conductances use a viscosity scaled up
+  // with the grain size; YADE has one viscosity for both. Read at every step.
+  double shear_viscosity = 0;
+  double viscosity_of_shear() const { return shear_viscosity > 0 ? shear_viscosity : conductance.viscosity; }
   // Buoyancy: the engine solves for the excess (piezometric) pressure, so the hydrostatic part of
   // the fluid's action is the force -fluid_density V g on every sphere, added to its fluid force
   // when fluid_density > 0 (thesis 2.17: the buoyant weight). 0: no buoyancy, no cost.

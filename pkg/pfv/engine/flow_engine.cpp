@@ -34,7 +34,7 @@ void FlowEngine::release() {
        {&pressure_, &volume_, &volume_rate_, &rhs_, &solution_, &next_volume_, &next_pressure_, &pressure_before_})
     std::vector<double>().swap(*v);
   for (auto* v : {&force_, &next_force_, &shear_force_, &next_shear_, &centres_prev_}) std::vector<Vec3>().swap(*v);
-  has_prev_ = keep_trend_ = false;
+  has_prev_ = keep_trend_ = pressures_solved_ = false;
   cells_.clear();
   std::vector<double>().swap(measured_void_volume_);
   strain_ = 0;
@@ -85,6 +85,7 @@ void FlowEngine::resume(const RunState& s, double dt) {
     throw;
   }
   pressure_ = s.pressure;
+  pressures_solved_ = true;  // saved after a step
   if (!s.cells.empty() || !s.void_volume.empty()) {
     // Flat cells are found again by the rebuild; the saved conditions hold them and the rest.
     cells_ = s.cells;
@@ -278,7 +279,8 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& 
   // start of the iterative solvers. (The direct solve of an incompressible fluid needs neither,
   // unless asked for: interpolate_on_remesh.)
   std::vector<double> pressure(mesh.mesh().n_cells(), settings.p_zero);
-  if (settings.interpolates() && has_mesh())
+  const bool interpolated = settings.interpolates() && has_mesh();
+  if (interpolated)
     for (int c = 0; c < mesh.mesh().n_cells(); ++c) {
       const int old = mesh_->tri.locate(mesh.cells.power_centre[c]);
       if (old >= 0) pressure[c] = pressure_[old];
@@ -298,8 +300,9 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& 
   mesh_ = std::make_unique<PoreMesh>(std::move(mesh));
   linear_ = std::move(linear);
   pressure_ = std::move(pressure);
-  pressure_before_.clear();        // other cells
-  cells_ = std::move(conditions);  // those of the old cells named cells by index: gone
+  pressures_solved_ = interpolated;  // else pZero: no history to extrapolate from
+  pressure_before_.clear();          // other cells
+  cells_ = std::move(conditions);    // those of the old cells named cells by index: gone
   std::vector<double>().swap(measured_void_volume_);
   const int nc = mesh_->mesh().n_cells();
   volume_.assign(mesh_->cells.volume.begin(), mesh_->cells.volume.end());
@@ -453,7 +456,7 @@ void FlowEngine::compute_forces(const std::vector<Vec3>& centres, const std::vec
   if (mesh_->shear) {
     t0 = StageClock::now();
     if (has_prev_ && centres_prev_.size() == centres.size())
-      mesh_->shear->add_forces(centres, centres_prev_, dt, settings.conductance.viscosity, next_force_, next_shear_);
+      mesh_->shear->add_forces(centres, centres_prev_, dt, settings.viscosity_of_shear(), next_force_, next_shear_);
     else
       next_shear_.assign(next_force_.size(), Vec3::Zero());  // no velocities yet
     step_times_.shear_forces = seconds_since(t0);
@@ -475,11 +478,15 @@ void FlowEngine::commit(const std::vector<Vec3>& centres, const BoxWalls& walls,
     if (!next_force_[v].allFinite()) throw std::domain_error("non-finite fluid force on vertex " + std::to_string(v));
 
   std::swap(volume_, next_volume_);
-  if (keep_trend_)
+  // The pressures before this step start the next one's extrapolation only if they were
+  // solved (or carried over) on this mesh: from pZero, 2 p - p0 would double the first solution
+  // and start the second step as far off as the first.
+  if (keep_trend_ && pressures_solved_)
     std::swap(pressure_before_, pressure_);  // kept for the next start; its buffer becomes scratch
   else if (!pressure_before_.empty())
     std::vector<double>().swap(pressure_before_);
   std::swap(pressure_, next_pressure_);
+  pressures_solved_ = true;
   std::swap(force_, next_force_);
   std::swap(shear_force_, next_shear_);
   strain_ += strain;

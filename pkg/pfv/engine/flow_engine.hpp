@@ -238,6 +238,7 @@ class FlowEngine {
   std::vector<double> field_values_;                 // scratch of apply_pressure_field
   std::vector<double> pressure_before_;              // the step before pressure_'s, on this mesh (extrapolated start)
   bool keep_trend_ = false;                          // the solver of this step wants the extrapolated start next
+  bool pressures_solved_ = false;                    // pressure_ solved on this mesh (or carried over), not pZero
   std::vector<Vec3> next_force_;
   std::vector<Vec3> shear_force_, next_shear_;  // only with viscous_shear
   std::vector<Vec3> centres_prev_;

@@ -67,7 +67,7 @@ void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const s
   linear_.solver->apply_inverse(system, rhs, x, settings.solve_control());
   for (int u = 0; u < nu; ++u) p_cells[system.unknown_cell[u]] = x[u];
   mesh_->cache.apply(p_cells, force);
-  if (mesh_->shear) mesh_->shear->add_velocity_forces(v, settings.conductance.viscosity, force, shear);
+  if (mesh_->shear) mesh_->shear->add_velocity_forces(v, settings.viscosity_of_shear(), force, shear);
   accel.resize(n);
   for (int k = 0; k < n; ++k) accel[k] = mass[k] > 0 ? Vec3(force[k] / mass[k]) : Vec3::Zero();
 }

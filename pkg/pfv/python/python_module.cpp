@@ -250,6 +250,9 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&EngineSettings::viscous_shear),
                     "Viscous shear between neighbouring spheres (YADE's viscousShear); switching it on remeshes at the "
                     "next step.")
+      .def_property("shear_viscosity", get_setting(&EngineSettings::shear_viscosity),
+                    set_setting(&EngineSettings::shear_viscosity),
+                    "The viscosity of the shear term when positive (0, the default: viscosity); a PFV extension.")
       .def("remesh_pending", exclusive(&FlowEngine::remesh_pending))
       .def("wait_for_remesh", exclusive([](const SharedEngine& e) {
              py::gil_scoped_release release;

@@ -50,6 +50,7 @@ CORE_NAME: dict[str, str] = {
     "yade_wall_throat_factor": "yade_wall_throat_factor",
     "solver": "solver",
     "max_factor_bytes": "max_factor_bytes",
+    "shear_viscosity": "shear_viscosity",
 }
 
 # YADE's useSolver numbers and the core's solver names (YADE's 2, Taucs, has no counterpart).

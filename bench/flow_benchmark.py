@@ -95,6 +95,8 @@ def _here():
 SCRIPT = os.path.join(_here(), os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0].endswith('.py')
                       else 'flow_benchmark.py')
 REPO = os.path.dirname(_here())
+sys.path.insert(0, _here())
+from proc_memory import reset_peak, rss_kb  # noqa: E402
 
 
 def log(*args):
@@ -373,23 +375,6 @@ def core_timer(flow):
     """The C++ engine of a pfv FlowEngine, whose step_times()['total'] is the wall time of its last
     core step (to split C++ from Python/exchange time), or None for YADE's engine."""
     return getattr(flow, 'core', None)
-
-
-def rss_kb(field='VmRSS'):
-    with open('/proc/self/status') as f:
-        for line in f:
-            if line.startswith(field + ':'):
-                return int(line.split()[1])
-    return -1
-
-
-def reset_peak():
-    try:
-        with open('/proc/self/clear_refs', 'w') as f:
-            f.write('5')
-        return True
-    except OSError:
-        return False
 
 
 def probe_points(L, n=3, margin=0.25):

@@ -44,8 +44,9 @@ with tempfile.TemporaryDirectory(prefix="pfv-growth-") as work:
         rows = {}
         for line in text.splitlines():
             cells = [c.strip() for c in line.strip().strip("|").split("|")]
-            if len(cells) == 9 and cells[0].isdigit():
-                rows[(int(cells[0]), cells[1])] = cells
+            digits = cells[0].replace("\u202f", "")
+            if len(cells) == 9 and digits.isdigit():
+                rows[(int(digits), cells[1])] = cells
         expected = {(n, k) for n in (3000, 6000) for k in ("yade", "pfv", "pfv-multigrid")}
         expected |= {(12000, "pfv"), (12000, "pfv-multigrid")}
         check("one row per size and engine", set(rows) == expected, str(sorted(rows)))

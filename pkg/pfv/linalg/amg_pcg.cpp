@@ -60,12 +60,6 @@ struct WorkVector {
   double* end() const { return data + n; }
 };
 
-double global_max(MPI_Comm comm, double local) {
-  double g = local;
-  MPI_Allreduce(&local, &g, 1, MPI_DOUBLE, MPI_MAX, comm);
-  return g;
-}
-
 double dot(HYPRE_ParVector a, HYPRE_ParVector b) {
   double d = 0;
   HYPRE_ParVectorInnerProd(a, b, &d);
@@ -203,29 +197,18 @@ AmgPcg::AmgPcg(MPI_Comm comm, const DistributedRows& rows, const AmgParameters& 
   HYPRE_BoomerAMGSetAggNumLevels(amg, parameters.aggressive_levels);
   check(HYPRE_BoomerAMGSetup(amg, m.a, m.b.par, m.x.par), "BoomerAMGSetup");
 
-  // Sizes of the hierarchy, from hypre's own data (its levels' matrices and interpolations).
+  // The operator complexity from hypre's own data: the entries of every level's matrix (global
+  // counts, the same on every process) over those of G.
   auto* data = reinterpret_cast<hypre_ParAMGData*>(amg);
-  const int levels = hypre_ParAMGDataNumLevels(data);
   hypre_ParCSRMatrix** a_levels = hypre_ParAMGDataAArray(data);
-  hypre_ParCSRMatrix** p_levels = hypre_ParAMGDataPArray(data);
-  double entries_g = 0, entries_a = 0, entries_all = 0, rows_all = 0;
-  for (int l = 0; l < levels; ++l) {
+  double entries_g = 0, entries_all = 0;
+  for (int l = 0; l < hypre_ParAMGDataNumLevels(data); ++l) {
     hypre_ParCSRMatrixSetNumNonzeros(a_levels[l]);
     const double e = static_cast<double>(hypre_ParCSRMatrixNumNonzeros(a_levels[l]));
     if (l == 0) entries_g = e;
-    entries_a += e;
     entries_all += e;
-    rows_all += static_cast<double>(hypre_ParCSRMatrixGlobalNumRows(a_levels[l]));
-    if (l + 1 < levels && p_levels && p_levels[l]) {
-      hypre_ParCSRMatrixSetNumNonzeros(p_levels[l]);
-      entries_all += static_cast<double>(hypre_ParCSRMatrixNumNonzeros(p_levels[l]));
-    }
   }
-  operator_complexity_ = entries_g > 0 ? entries_a / entries_g : 0;
-  // Entries take a value and a column index; rows a start, and per level a few work vectors.
-  bytes_ = entries_all * (sizeof(double) + sizeof(HYPRE_Int)) + rows_all * (sizeof(HYPRE_Int) + 4 * sizeof(double)) +
-           6.0 * n * sizeof(double);
-  bytes_ = global_max(comm, bytes_);  // each process's share is alike; report the largest
+  operator_complexity_ = entries_g > 0 ? entries_all / entries_g : 0;
 }
 
 AmgPcg::~AmgPcg() = default;

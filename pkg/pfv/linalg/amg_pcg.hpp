@@ -81,13 +81,11 @@ class AmgPcg {
   int levels() const;
   // Entries of all levels' matrices over those of G (hypre's operator complexity).
   double operator_complexity() const { return operator_complexity_; }
-  // Bytes held by the hierarchy, the matrix and the work vectors (an estimate from their entries).
-  double bytes() const { return bytes_; }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
-  double operator_complexity_ = 0, bytes_ = 0;
+  double operator_complexity_ = 0;
   double seen_ratio_ = 0;  // the largest update ratio of the last solve with two iterations or more
 };
 

@@ -26,24 +26,45 @@ THESIS_TABLE_3_2 = {
 }
 
 
+def observed_order(s, k):
+    """The order q of kappa(s) = kappa_inf - C s^q through three levels (any refinement ratios):
+    the root of (k3 - k2) / (k2 - k1) = (s2^q - s3^q) / (s1^q - s2^q), by bisection on
+    [0.1, 8]; nan when the changes do not shrink monotonically."""
+    ratio = (k[2] - k[1]) / (k[1] - k[0])
+    if not 0 < ratio < 1:
+        return float("nan")
+
+    def g(q):
+        return (s[1] ** q - s[2] ** q) / (s[0] ** q - s[1] ** q) - ratio
+
+    lo, hi = 0.1, 8.0
+    if g(lo) * g(hi) > 0:
+        return float("nan")
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(lo) * g(mid) > 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def fem_estimate(levels, lateral):
-    """(finest kappa, change from the previous level, Richardson estimate with the observed order)."""
+    """(finest kappa, change from the previous level, Richardson estimate with the observed
+    order of the last three levels, that order)."""
     k = [lv[lateral]["kappa"] for lv in levels]
-    h = [lv["h"] for lv in levels]
+    s = [lv["surface"] for lv in levels]
     if len(k) < 2:
-        return k[-1], float("nan"), float("nan")
+        return k[-1], float("nan"), float("nan"), float("nan")
     change = k[-1] / k[-2] - 1
-    extrapolated = float("nan")
-    if len(k) >= 3 and (k[-2] - k[-3]) != 0 and (k[-1] - k[-2]) / (k[-2] - k[-3]) > 0:
-        ratio = (k[-1] - k[-2]) / (k[-2] - k[-3])
-        order = np.log(ratio) / np.log(h[-1] / h[-2]) if h[-1] / h[-2] != 1 else float("nan")
-        if order > 0.5:
-            extrapolated = k[-1] + (k[-1] - k[-2]) / ((h[-2] / h[-1]) ** order - 1)
-    return k[-1], change, extrapolated
+    extrapolated = order = float("nan")
+    if len(k) >= 3:
+        order = observed_order(s[-3:], k[-3:])
+        if np.isfinite(order):
+            c = (k[-1] - k[-2]) / (s[-2] ** order - s[-1] ** order)
+            extrapolated = k[-1] + c * s[-1] ** order
+    return k[-1], change, extrapolated, order
 
 
 def convergence_table(results):
-    lines = ["| case | h | DOFs | κ_FEM sym | change | κ_FEM no-slip | change | solve (s) sym / no-slip |",
+    lines = ["| case | surface size | DOFs | κ_FEM sym | change | κ_FEM no-slip | change | solve (s) sym / no-slip |",
              "|---|---|---|---|---|---|---|---|"]
     for r in results:
         prev = None
@@ -52,8 +73,18 @@ def convergence_table(results):
             cs = "" if prev is None else "%+.2f %%" % (100 * (s["kappa"] / prev[0] - 1))
             cn = "" if prev is None else "%+.2f %%" % (100 * (n["kappa"] / prev[1] - 1))
             lines.append("| %s | %.3f | %d | %.4e | %s | %.4e | %s | %.0f / %.0f |" % (
-                r["case"], lv["h"], s["dofs"], s["kappa"], cs, n["kappa"], cn, s["seconds_solve"], n["seconds_solve"]))
+                r["case"], lv["surface"], s["dofs"], s["kappa"], cs, n["kappa"], cn,
+                s["seconds_solve"], n["seconds_solve"]))
             prev = (s["kappa"], n["kappa"])
+        if len(r["fem"]) >= 3:
+            cells = []
+            for lateral in ("symmetry", "noslip"):
+                finest, _, estimate, order = fem_estimate(r["fem"], lateral)
+                if np.isfinite(estimate):
+                    cells += ["%.4e" % estimate, "q = %.1f, finest %+.2f %%" % (order, 100 * (finest / estimate - 1))]
+                else:
+                    cells += ["–", "no monotone order"]
+            lines.append("| %s | → 0 (Richardson) | | %s | %s | %s | %s | |" % ((r["case"],) + tuple(cells)))
     return "\n".join(lines)
 
 
@@ -66,8 +97,8 @@ def yade_kappa(r, variant):
 def kappa_rows(results):
     rows = []
     for r in results:
-        ks, _, es = fem_estimate(r["fem"], "symmetry")
-        kn, _, en = fem_estimate(r["fem"], "noslip")
+        ks, _, es, _ = fem_estimate(r["fem"], "symmetry")
+        kn, _, en, _ = fem_estimate(r["fem"], "noslip")
         rows.append({
             "case": r["case"], "n": r["n"], "porosity": r["porosity"],
             # the reference: the Richardson estimate where three levels give one, else the finest mesh

@@ -1,13 +1,13 @@
 """Stokes (FEM) against PFV and YADE on the thesis' frozen packings (section 3.5): the driver.
 
-    /usr/bin/python3 bench/stokes/run.py [--cases=a,b] [--levels=0.16,0.12,0.09] [--out=FILE]
+    /usr/bin/python3 bench/stokes/run.py [--cases=a,b] [--levels=0.048,0.034,0.024] [--out=FILE]
     /usr/bin/python3 bench/stokes/run.py --quick [--write-reference]
 
 Needs the pfv package on PYTHONPATH (a build tree's python/ folder) and, for the YADE column,
-yade-double on PATH. For every case and every mesh size h of --levels it solves Stokes flow with
-symmetry and with no-slip lateral faces (solve.py), then runs PFV (no-slip walls, slip walls with
-the thesis' formula, slip walls with YADE's factor; pfv_model.py) and YADE's engine
-(yade_model.py) on the same spheres. Results are appended case by case to --out (JSON).
+yade-double on PATH. For every case and every sphere-surface element size of --levels (mesh.py)
+it solves Stokes flow with symmetry and with no-slip lateral faces (solve.py), then runs PFV
+(no-slip walls, slip walls with the thesis' formula, slip walls with YADE's factor;
+pfv_model.py) and YADE's engine (yade_model.py) on the same spheres. Results are appended case by case to --out (JSON).
 
 --quick runs the CI case: the 8-sphere packing on one coarse mesh; with --write-reference it
 writes tests/data/stokes_fem_quick.json, else it compares with that file and exits 1 on a
@@ -34,7 +34,7 @@ import solve  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(HERE))
 REFERENCE = os.path.join(ROOT, "tests", "data", "stokes_fem_quick.json")
 SHRINK = 0.01
-QUICK_H = 0.2
+QUICK_SURFACE = 0.048
 D_OVER_D = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.72, 0.8)
 
 
@@ -71,11 +71,11 @@ def run_yade(packing):
             return json.load(f)
 
 
-def fem_case(packing, h, laterals=("symmetry", "noslip")):
+def fem_case(packing, surface, laterals=("symmetry", "noslip")):
     start = time.perf_counter()
-    msh, _, facets = fem_mesh.build(packing, h)
+    msh, _, facets = fem_mesh.build(packing, surface)
     meshed = time.perf_counter() - start
-    out = {"h": h, "seconds_mesh": meshed}
+    out = {"surface": surface, "seconds_mesh": meshed}
     for lateral in laterals:
         out[lateral] = solve.solve(msh, facets, len(packing["radii"]), lateral)
     return out
@@ -89,21 +89,21 @@ def run_case(name, levels, with_yade=True, log=print, save=lambda r: None):
         result["pfv"][variant] = pfv_model.run(packing, variant)
     if with_yade:
         result["yade"] = run_yade(packing)
-    for h in levels:
-        level = fem_case(packing, h)
+    for surface in levels:
+        level = fem_case(packing, surface)
         result["fem"].append(level)
         save(result)
-        log("%-22s h %.3f  dofs %8d  kappa sym %.5e  noslip %.5e  mesh %.0f s  solve %.0f + %.0f s" % (
-            name, h, level["symmetry"]["dofs"], level["symmetry"]["kappa"], level["noslip"]["kappa"],
+        log("%-22s surface %.3f  dofs %8d  kappa sym %.5e  noslip %.5e  mesh %.0f s  solve %.0f + %.0f s" % (
+            name, surface, level["symmetry"]["dofs"], level["symmetry"]["kappa"], level["noslip"]["kappa"],
             level["seconds_mesh"], level["symmetry"]["seconds_solve"], level["noslip"]["seconds_solve"]))
     return result
 
 
 def quick_numbers():
     """The CI case: 8 spheres, one coarse mesh, both lateral conditions; FEM and PFV."""
-    r = run_case("cubic8", [QUICK_H], with_yade=False, log=lambda *a: None)
+    r = run_case("cubic8", [QUICK_SURFACE], with_yade=False, log=lambda *a: None)
     fem = r["fem"][0]
-    out = {"h": QUICK_H, "shrink": SHRINK}
+    out = {"surface": QUICK_SURFACE, "shrink": SHRINK}
     for lateral in ("symmetry", "noslip"):
         s = fem[lateral]
         fy = [s["forces"]["sphere%d" % k]["pressure"][1] + s["forces"]["sphere%d" % k]["viscous"][1]
@@ -135,7 +135,7 @@ def compare_quick(now, ref):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--cases", default=",".join(all_cases()))
-    ap.add_argument("--levels", default="0.16,0.12,0.09")
+    ap.add_argument("--levels", default="0.048,0.034,0.024")
     ap.add_argument("--out", default=os.path.join(HERE, "results", "stokes_results.json"))
     ap.add_argument("--no-yade", action="store_true")
     ap.add_argument("--quick", action="store_true")
@@ -157,7 +157,7 @@ def main():
         print("%d passed, %d failed" % (len(rows) - failed, failed))
         return 1 if failed else 0
 
-    levels = [float(h) for h in args.levels.split(",")]
+    levels = [float(x) for x in args.levels.split(",")]
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     results = []
     if os.path.exists(args.out):

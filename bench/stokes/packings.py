@@ -103,3 +103,10 @@ def load(path):
     p["centres"] = np.asarray(p["centres"], dtype=float)
     p["radii"] = np.asarray(p["radii"], dtype=float)
     return p
+
+
+if __name__ == "__main__":
+    # python3 packings.py N RATIO SEED OUT.json: a random packing for run.py's random<N> case
+    import sys
+    n, ratio, seed, path = int(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+    save(random_packing(n, ratio, seed), path)

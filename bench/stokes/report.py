@@ -63,18 +63,25 @@ def fem_estimate(levels, lateral):
     return k[-1], change, extrapolated, order
 
 
+def balance(solution):
+    """|Q_in - Q_out| / Q of one FEM solution: Taylor-Hood is not locally conservative, and a mesh
+    too coarse for the throats shows it first here."""
+    return abs(solution["flux_in"] - solution["flux_out"]) / abs(solution["kappa"])
+
+
 def convergence_table(results):
-    lines = ["| case | surface size | DOFs | κ_FEM sym | change | κ_FEM no-slip | change | solve (s) sym / no-slip |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| case | surface size | DOFs | κ_FEM sym | change | κ_FEM no-slip | change | solve (s) sym / no-slip "
+             "| \\|Q_in − Q_out\\| / Q sym / no-slip |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         prev = None
         for lv in r["fem"]:
             s, n = lv["symmetry"], lv["noslip"]
             cs = "" if prev is None else "%+.2f %%" % (100 * (s["kappa"] / prev[0] - 1))
             cn = "" if prev is None else "%+.2f %%" % (100 * (n["kappa"] / prev[1] - 1))
-            lines.append("| %s | %.3f | %d | %.4e | %s | %.4e | %s | %.0f / %.0f |" % (
+            lines.append("| %s | %.3f | %d | %.4e | %s | %.4e | %s | %.0f / %.0f | %.1e / %.1e |" % (
                 r["case"], lv["surface"], s["dofs"], s["kappa"], cs, n["kappa"], cn,
-                s["seconds_solve"], n["seconds_solve"]))
+                s["seconds_solve"], n["seconds_solve"], balance(s), balance(n)))
             prev = (s["kappa"], n["kappa"])
         if len(r["fem"]) >= 3:
             cells = []
@@ -84,7 +91,7 @@ def convergence_table(results):
                     cells += ["%.4e" % estimate, "q = %.1f, finest %+.2f %%" % (order, 100 * (finest / estimate - 1))]
                 else:
                     cells += ["–", "no monotone order"]
-            lines.append("| %s | → 0 (Richardson) | | %s | %s | %s | %s | |" % ((r["case"],) + tuple(cells)))
+            lines.append("| %s | → 0 (Richardson) | | %s | %s | %s | %s | | |" % ((r["case"],) + tuple(cells)))
     return "\n".join(lines)
 
 
@@ -94,9 +101,18 @@ def yade_kappa(r, variant):
     return float("nan") if v is None else v
 
 
+RESOLVED = 0.01  # |Q_in - Q_out| / Q of the finest mesh below which a case enters the comparison
+
+
+def unresolved(results):
+    return [r["case"] for r in results if max(balance(r["fem"][-1][lat]) for lat in ("symmetry", "noslip")) > RESOLVED]
+
+
 def kappa_rows(results):
     rows = []
     for r in results:
+        if r["case"] in unresolved(results):
+            continue
         ks, _, es, _ = fem_estimate(r["fem"], "symmetry")
         kn, _, en, _ = fem_estimate(r["fem"], "noslip")
         rows.append({
@@ -213,10 +229,32 @@ def figure(rows, path):
     fig.savefig(path, dpi=110)
 
 
+def shrink_table(rows):
+    """The shrink's effect: each ratio kappa_model / kappa_FEM at the default shrink against the same
+    packing shrunk by another amount (cases named <case>@<shrink>)."""
+    by_case = {w["case"]: w for w in rows}
+    pairs = [(by_case[c.split("@")[0]], w) for c, w in by_case.items() if "@" in c and c.split("@")[0] in by_case]
+    if not pairs:
+        return ""
+    lines = ["| case | ratio | shrink 1 %% | shrink %s | difference |" % "/".join(
+        sorted({"%g %%" % (100 * float(w["case"].split("@")[1])) for _, w in pairs})), "|---|---|---|---|---|"]
+    for base, other in pairs:
+        for key, ref, label in (("pfv_slip", "fem_sym", "PFV slip, thesis"), ("pfv_slip_yade", "fem_sym",
+                                "PFV slip, YADE factor"), ("pfv_noslip", "fem_noslip", "PFV no-slip"),
+                                ("yade_slip", "fem_sym", "YADE slip"), ("yade_noslip", "fem_noslip", "YADE no-slip")):
+            a, b = base[key] / base[ref], other[key] / other[ref]
+            lines.append("| %s | %s | %.3f | %.3f | %+.1f %% |" % (base["case"], label, a, b, 100 * (b / a - 1)))
+        lines.append("| %s | κ_FEM sym / no-slip | %.4e / %.4e | %.4e / %.4e | %+.1f %% / %+.1f %% |" % (
+            base["case"], base["fem_sym"], base["fem_noslip"], other["fem_sym"], other["fem_noslip"],
+            100 * (other["fem_sym"] / base["fem_sym"] - 1), 100 * (other["fem_noslip"] / base["fem_noslip"] - 1)))
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--results", default=",".join(os.path.join(HERE, "results", f)
-                                                  for f in ("stokes_results.json", "stokes_series.json")))
+                                                  for f in ("stokes_results.json", "stokes_series.json",
+                                                            "stokes_shrink.json", "stokes_random200.json")))
     ap.add_argument("--figure", default=os.path.join(ROOT, "doc", "figures", "stokes-kappa.png"))
     args = ap.parse_args()
     results = {}
@@ -224,12 +262,15 @@ def main():
         if os.path.exists(path):
             with open(path) as f:
                 results.update({r["case"]: r for r in json.load(f)})
-    order = ["cubic8", "centred9_0.72", "random25", "random54"]
+    order = ["cubic8", "centred9_0.72", "random25", "random54", "random200"]
     results = sorted(results.values(), key=lambda r: (order.index(r["case"]) if r["case"] in order else 9, r["case"]))
     rows = kappa_rows(results)
     print("## convergence\n\n" + convergence_table(results))
     print("\n## permeability\n\n" + kappa_table(rows))
+    left_out = ", ".join(unresolved(results)) or "none"
+    print("\nleft out, the finest mesh's flux balance above %g: %s" % (RESOLVED, left_out))
     print("\n## summary\n\n" + summary(rows))
+    print("\n## shrink\n\n" + shrink_table(rows))
     print("\n## forces, 9 spheres, d/D = 0.72, no-slip\n\n" + forces_072(results))
     if any(w["case"].startswith("centred9_") for w in rows):
         figure(rows, args.figure)

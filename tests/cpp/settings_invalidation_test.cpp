@@ -46,7 +46,7 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
       {"min_k_div_k_mean", [](FlowEngine& e) { e.settings.conductance.min_ratio = 1e-3; }},
       {"max_k_div_k_mean", [](FlowEngine& e) { e.settings.conductance.max_ratio = 50.0; }},
       {"slip_boundary", [](FlowEngine& e) { e.settings.slip_boundary = false; }},
-      {"yade_wall_throat_factor", [](FlowEngine& e) { e.settings.yade_wall_throat_factor = true; }},
+      {"yade_wall_throat_factor", [](FlowEngine& e) { e.settings.yade_wall_throat_factor = false; }},
       {"viscous_shear", [](FlowEngine& e) { e.settings.viscous_shear = true; }},
       {"viscosity", [](FlowEngine& e) { e.settings.conductance.viscosity = 2.0; }},
       {"solver", [](FlowEngine& e) { e.settings.solver = SolverKind::kConjugateGradient; }},

@@ -1,7 +1,7 @@
 # Run one of YADE's own FlowEngine client scripts unchanged, with YADE's built-in FlowEngine
 # or with pfv.FlowEngine substituted for it.
 #
-#   yade-double -n -x tests/yade/run_yade_script.py SCRIPT [--pfv [--yade-wall-throats]]
+#   yade-double -n -x tests/yade/run_yade_script.py SCRIPT [--pfv [--thesis-wall-throats]]
 #
 # SCRIPT is a path, or one of the shortcuts
 #   check       -> <yade libDir>/py/yade/tests/checks/DEM-PFV-check.py
@@ -9,8 +9,9 @@
 # The script is exec'd in __main__'s own namespace (PyRunner commands such as 'history()' are evaluated there,
 # so a copy would not do); `O`, `FlowEngine`, `aabbWalls`, ... are there already;
 # `checksPath` and `YadeCheckError` are defined as `yade --check` does.  With --pfv the name `FlowEngine`
-# in that namespace is bound to pfv.FlowEngine (with --yade-wall-throats, to pfv.FlowEngine with the
-# opt-in yade_wall_throat_factor on: YADE's slip-wall multiplier).  GUI plotting calls are made harmless.
+# in that namespace is bound to pfv.FlowEngine (with --thesis-wall-throats, to pfv.FlowEngine with
+# yade_wall_throat_factor=False: the thesis' slip-wall formula without YADE's multiplier).  GUI plotting calls are
+# made harmless.
 # Exit code: 0 if the script ran to the end, 1 on any exception (including YadeCheckError) or if pfv is missing.
 import sys, os, time, traceback
 import yade
@@ -42,9 +43,9 @@ def main(argv):
             print('PFV_IMPORT_FAILED: cannot import pfv (%s: %s)' % (type(e).__name__, e))
             return 1
         ns['FlowEngine'] = pfv.FlowEngine
-        if '--yade-wall-throats' in argv:
+        if '--thesis-wall-throats' in argv:
             import functools
-            ns['FlowEngine'] = functools.partial(pfv.FlowEngine, yade_wall_throat_factor=True)
+            ns['FlowEngine'] = functools.partial(pfv.FlowEngine, yade_wall_throat_factor=False)
     try:  # no GUI: plot.plot() would try to open a window
         from yade import plot
         plot.plot = lambda *a, **k: None

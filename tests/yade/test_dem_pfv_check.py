@@ -2,14 +2,14 @@
 
     yade-double -n -x tests/yade/test_dem_pfv_check.py        (exit 0 = pass)
 
-With only the engine swapped the script runs to its end and reports its three figures
-(permeability, consolidation pressure, settlement) beyond its 10 % tolerance: PFV computes the
-conductance of wall throats by the thesis' formula, YADE multiplies their R_h by 2^-1/4 or 2^-1/2
-with slipBoundary (doc/yade.md, doc/validation.md). The permeability is then higher by the
-size of that term (a quarter on this 100-sphere scene), and the two consolidation figures
-follow from it. With YADE's multiplier switched on (yade_wall_throat_factor) the same script
-passes YADE's own tolerances: the difference is that term and nothing else. forceMetis must
-give a METIS ordering in both runs.
+With only the engine swapped the script runs to its end and passes YADE's own tolerances
+(permeability, consolidation pressure, settlement within 10 %), and its permeability is that of
+YADE's engine run on the same script to 1 %: pfv.FlowEngine multiplies R_h of wall throats by
+2^-1/4 or 2^-1/2 with slipBoundary, as YADE does (yade_wall_throat_factor, on by default because
+of the Stokes comparison of doc/validation.md section 7). With the thesis' formula alone
+(yade_wall_throat_factor=False) the permeability is higher by the size of that term (a quarter on
+this 100-sphere scene) and the script stops at its first check. forceMetis must give a METIS
+ordering in both PFV runs.
 """
 import os
 import re
@@ -21,8 +21,7 @@ failures = []
 
 
 def run(*flags):
-    cmd = ["yade-double",
-           "-n", "-x", os.path.join(HERE, "run_yade_script.py"), "check", "--pfv", *flags]
+    cmd = ["yade-double", "-n", "-x", os.path.join(HERE, "run_yade_script.py"), "check", *flags]
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
     return done.returncode, done.stdout + done.stderr
 
@@ -38,19 +37,27 @@ def check(what, ok, detail=""):
         failures.append(what)
 
 
-code, plain = run()
-check("engine swapped: the script runs to its checks", "YadeCheckError" in plain and "Traceback" in plain
-      and "DEM-PFV: unbalanced" not in plain, f"(exit {code})")
-k_plain = permeability(plain)
-code, yade_walls = run("--yade-wall-throats")
-check("with YADE's wall-throat multiplier: passes YADE's own tolerances", code == 0
-      and "OK: DEM-PFV-check.py finished" in yade_walls, f"(exit {code})")
+code, yade_engine = run()
+check("YADE's own engine passes its own check", code == 0 and "OK: DEM-PFV-check.py finished" in yade_engine,
+      f"(exit {code})")
+code, plain = run("--pfv")
+check("engine swapped: passes YADE's own tolerances", code == 0 and "OK: DEM-PFV-check.py finished" in plain,
+      f"(exit {code})")
+code, thesis = run("--pfv", "--thesis-wall-throats")
+check("thesis' wall formula: the script runs to its checks and stops there", "YadeCheckError" in thesis
+      and "Traceback" in thesis and "DEM-PFV: unbalanced" not in thesis, f"(exit {code})")
 target = 0.040399916554  # the script's own reference, YADE's engine
-k_yade = permeability(yade_walls) or target  # printed only when more than 1 % off
+k_thesis = permeability(thesis)
+k_plain = permeability(plain) or target  # printed only when more than 1 % off
+k_yade = permeability(yade_engine) or target
+# The script's packing comes from its own DEM compaction, which this build of YADE does not reproduce
+# bit for bit: its target is 9 % below YADE's engine here, so PFV is compared with the engine itself.
+check("by default PFV's permeability is YADE's engine's on the same packing (1 %)",
+      abs(k_plain / k_yade - 1) < 0.01, f"(k = {k_plain} vs {k_yade})")
 check("the thesis' wall formula raises the permeability by the size of the wall term",
-      k_plain is not None and 1.15 < k_plain / k_yade < 1.45,
-      f"(k = {k_plain} vs {k_yade} with the multiplier, target {target})")
-for name, text in (("plain", plain), ("multiplier", yade_walls)):
+      k_thesis is not None and 1.15 < k_thesis / k_plain < 1.45,
+      f"(k = {k_thesis} vs {k_plain} by default, target {target})")
+for name, text in (("default", plain), ("thesis formula", thesis)):
     check(f"forceMetis gives a METIS ordering ({name})", "Metis is not used" not in text)
 
 if failures:

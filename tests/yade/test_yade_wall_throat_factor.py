@@ -1,15 +1,15 @@
-"""pfv.FlowEngine with yade_wall_throat_factor reproduces YADE's permeability with slip walls.
+"""pfv.FlowEngine reproduces YADE's permeability with slip walls; yade_wall_throat_factor=False does not.
 
     yade-double -n -x tests/yade/test_yade_wall_throat_factor.py      (exit 0 = pass)
 
 The shipped 1000-sphere permeameter (scenes.build_permeameter), pressure drop along y, slip
 lateral walls (YADE's default slipBoundary=True), every other attribute at its default. YADE's
-engine multiplies R_h of wall throats by 2^-1/4 or 2^-1/2; pfv.FlowEngine does so only with
-yade_wall_throat_factor=True. Checks:
-  * with the factor, PFV's outflux is within 1 % of YADE's (the remaining difference is the
+engine multiplies R_h of wall throats by 2^-1/4 or 2^-1/2; so does pfv.FlowEngine with
+yade_wall_throat_factor=True, its default. Checks:
+  * by default, PFV's outflux is within 1 % of YADE's (the remaining difference is the
     throat partition of doc/yade.md, difference 2, 0.3-0.4 % with no-slip walls);
-  * without it (the default), PFV's outflux is more than 10 % above YADE's: the factor is what
-    separates the engines on slip walls;
+  * with the factor off (the thesis' formula alone), PFV's outflux is more than 10 % above
+    YADE's: the factor is what separates the formulas on slip walls;
   * the factor leaves no-slip walls alone: identical fluxes with and without it.
 """
 import os
@@ -44,13 +44,13 @@ def main():
 
     q_yade = outflux(YadeFlow)
     q_pfv = outflux(PfvFlow)
-    q_pfv_factor = outflux(PfvFlow, yade_wall_throat_factor=True)
-    print('outflux: YADE %.9e, PFV %.9e, PFV with the factor %.9e' % (q_yade, q_pfv, q_pfv_factor))
-    off = abs(q_pfv_factor / q_yade - 1)
-    check('slip walls, factor on: |Q_pfv / Q_yade - 1|', off, off < 0.01)
-    check('slip walls, factor off (default): Q_pfv / Q_yade - 1', q_pfv / q_yade - 1, q_pfv / q_yade - 1 > 0.10)
-    q_ns = outflux(PfvFlow, slip=False)
-    q_ns_factor = outflux(PfvFlow, slip=False, yade_wall_throat_factor=True)
+    q_pfv_thesis = outflux(PfvFlow, yade_wall_throat_factor=False)
+    print('outflux: YADE %.9e, PFV %.9e, PFV with the thesis formula %.9e' % (q_yade, q_pfv, q_pfv_thesis))
+    off = abs(q_pfv / q_yade - 1)
+    check('slip walls, default (factor on): |Q_pfv / Q_yade - 1|', off, off < 0.01)
+    check('slip walls, factor off: Q_pfv / Q_yade - 1', q_pfv_thesis / q_yade - 1, q_pfv_thesis / q_yade - 1 > 0.10)
+    q_ns = outflux(PfvFlow, slip=False, yade_wall_throat_factor=False)
+    q_ns_factor = outflux(PfvFlow, slip=False)
     check('no-slip walls: |Q(factor) / Q(no factor) - 1|', abs(q_ns_factor / q_ns - 1), q_ns_factor == q_ns)
     failed = sum(1 for r in rows if not r[2])
     print('%d passed, %d failed' % (len(rows) - failed, failed))

@@ -20,7 +20,7 @@ struct MeshRecipe {
   ConductanceModel conductance;
   bool slip_boundary = true;
   bool viscous_shear = false;
-  bool yade_wall_throat_factor = false;
+  bool yade_wall_throat_factor = true;
 
   explicit MeshRecipe(const EngineSettings& s)
       : conductance(s.conductance),

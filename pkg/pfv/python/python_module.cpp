@@ -169,10 +169,12 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&ConductanceModel::max_ratio))
       .def_property("slip_boundary", get_setting(&EngineSettings::slip_boundary),
                     set_setting(&EngineSettings::slip_boundary))
-      .def_property("yade_wall_throat_factor", get_setting(&EngineSettings::yade_wall_throat_factor),
-                    set_setting(&EngineSettings::yade_wall_throat_factor),
-                    "With slip_boundary: YADE's factor on R_h of wall throats (2^-1/4 with one wall vertex, 2^-1/2 "
-                    "with two), off by default; remeshes at the next step.")
+      .def_property(
+          "yade_wall_throat_factor", get_setting(&EngineSettings::yade_wall_throat_factor),
+          set_setting(&EngineSettings::yade_wall_throat_factor),
+          "With slip_boundary: YADE's factor on R_h of wall throats (2^-1/4 with one wall vertex, 2^-1/2 "
+          "with two), as YADE's engine does; on by default, False for the thesis' formula alone; remeshes at the "
+          "next step.")
       .def_property("solver",
                     exclusive([](const SharedEngine& e) { return std::string(to_string(e.settings.solver)); }),
                     exclusive([](SharedEngine& e, const std::string& v) {

@@ -656,7 +656,9 @@ def run(opts):
                    isochrone_rms_error_layer=rms(r['p_over_load'] - r['p_theory_layer_over_load'] for r in iso_win),
                    U_max_abs_error_all=max(abs(r['U_sim'] - r['U_theory']) for r in rows),
                    isochrone_rms_error_all=rms(r['p_over_load'] - r['p_theory_over_load'] for r in iso),
+                   # the whole record (the servo's loading transient included) and the quasi-static window
                    max_p_mid_over_load=max(r['p_mid'] for r in rows) / P['load'],
+                   max_p_mid_over_load_window=max(r['p_mid'] for r in win) / P['load'],
                    # claim 18: pore pressure + effective stress increment = the load increment along the height
                    p_plus_sigma_eff_max_error_Tv01=max((abs(r['p_plus_d_sigma_eff_over_load'] - 1) for r in iso
                                                         if r['Tv_target'] == 0.1), default=float('nan')),

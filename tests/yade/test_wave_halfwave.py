@@ -21,13 +21,13 @@ Errors, relative to A (head) or to the largest interval flux (velocity):
 Measured (yade-double -j1, WAVE_SIZES=8,12,16,20 yade-double -n -x tests/yade/test_wave_halfwave.py):
 
     layers  spheres  engine  head_rms  head_probe  velocity
-       8       512   PFV     0.0135    0.0446      0.0598
+       8       512   PFV     0.0149    0.0471      0.0515
        8       512   YADE    0.0448    0.0825      0.0630
-      12      1728   PFV     0.0135    0.0555      0.0753
+      12      1728   PFV     0.0121    0.0514      0.0635
       12      1728   YADE    0.0324    0.0863      0.0847
-      16      4096   PFV     0.0063    0.0381      0.0579
+      16      4096   PFV     0.0064    0.0387      0.0594
       16      4096   YADE    0.0325    0.0734      0.0907
-      20      8000   PFV     0.0052    0.0155      0.0425
+      20      8000   PFV     0.0053    0.0175      0.0440
       20      8000   YADE    0.0349    0.0510      0.1197
 
 PFV's errors fall with the grain size (pore-scale scatter, and the boundary layer of cells whose
@@ -59,8 +59,8 @@ L, H, W = 2.0, 1.0, 0.5
 A = 1.0
 SIZES = tuple(int(v) for v in os.environ.get('WAVE_SIZES', '12,20').split(','))  # layers over h
 # 1.5 x PFV's measured errors (module docstring), per number of layers: head_rms, head_probe, velocity.
-TOLERANCE = {8: (0.020, 0.067, 0.090), 12: (0.020, 0.083, 0.113), 16: (0.0095, 0.057, 0.087),
-             20: (0.0078, 0.023, 0.064)}
+TOLERANCE = {8: (0.022, 0.071, 0.077), 12: (0.018, 0.077, 0.095), 16: (0.0096, 0.058, 0.089),
+             20: (0.0080, 0.026, 0.066)}
 failures = []
 
 

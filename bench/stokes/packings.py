@@ -106,7 +106,11 @@ def load(path):
 
 
 if __name__ == "__main__":
-    # python3 packings.py N RATIO SEED OUT.json: a random packing for run.py's random<N> case
+    # python3 packings.py N RATIO SEED data/NAME.json: a random packing for run.py's case NAME
+    # (random<N>, or random<N>s<SEED> for further seeds)
+    import os
     import sys
     n, ratio, seed, path = int(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
-    save(random_packing(n, ratio, seed), path)
+    packing = random_packing(n, ratio, seed)
+    packing["name"] = os.path.splitext(os.path.basename(path))[0]
+    save(packing, path)

@@ -26,6 +26,10 @@ THESIS_TABLE_3_2 = {
 }
 
 
+# the thesis' mean kappa_HR / kappa_FEM over its packings (section 3.5.3, Fig. 3.12)
+THESIS_MEAN = {"symmetry": 1.01, "noslip": 0.78}
+
+
 def observed_order(s, k):
     """The order q of kappa(s) = kappa_inf - C s^q through three levels (any refinement ratios):
     the root of (k3 - k2) / (k2 - k1) = (s2^q - s3^q) / (s1^q - s2^q), by bisection on
@@ -225,6 +229,11 @@ def figure(rows, path):
     for i, (key, ref, label, style) in enumerate(styles):
         b.plot(pos + (i - 2) * 0.06, [w[key] / w[ref] for w in packs], style[0], label=label)
     b.axhline(1, color="k", lw=0.5)
+    for ax in (a, b):  # the thesis' means over its cases (section 3.5.3, Fig. 3.12)
+        ax.axhline(THESIS_MEAN["symmetry"], color="tab:blue", lw=0.8, ls=(0, (1, 3)))
+        ax.axhline(THESIS_MEAN["noslip"], color="tab:red", lw=0.8, ls=(0, (1, 3)))
+    b.text(pos[-1] + 0.3, THESIS_MEAN["symmetry"], "thesis, symmetry", fontsize=7, va="bottom", ha="right")
+    b.text(pos[-1] + 0.3, THESIS_MEAN["noslip"], "thesis, no-slip", fontsize=7, va="bottom", ha="right")
     b.set_xticks(pos)
     b.set_xticklabels(names)
     b.set_xlabel("packing (number of spheres)")

@@ -34,6 +34,9 @@ Options (each an engine, all stepped in lockstep on the same positions)
                  the previous pressures until the estimated error < refinement_tolerance * the pressure spread): at the default
                  refinement_tolerance 1e-10 and at 1e-6; in the oedometers on the interval-10 and defTolerance-0.01
                  schedules, and compared also with the double CHOLMOD on the same schedule ("same mesh")
+  multigrid      CG preconditioned by one BoomerAMG V-cycle (solver 'multigrid', warm-started, stopped when the
+                 estimated error < refinement_tolerance * the pressure spread): 1e-4 ... 1e-10 on the permeameter,
+                 1e-6 and 1e-10 in the oedometers on the solver sweeps' schedule
   background     CHOLMOD with background_remesh on (the mesh is built on a second thread); the driver waits for it
                  before the next step, so the new mesh is always one step old (deterministic)
 
@@ -73,6 +76,9 @@ DT = 1e-3
 SAMPLE = 5                  # oedometer: slice pressure and forces every SAMPLE steps
 SOLVER_INTERVAL = 100       # oedometer: remesh interval of the solver sweeps
 TOLS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
+MULTIGRID = 4               # the solver code of solver='multigrid' here (YADE has no number for it)
+# multigrid: refinement_tolerance, relative to the pressure spread (permeameter: all; oedometers: every other)
+AMG_TOLS = [1e-4, 1e-6, 1e-8, 1e-10]
 # scene: (steps, eps_f, tau as a fraction of steps)
 SCENES = {'slow': (1000, 0.01, 0.25), 'fast': (200, 0.05, 0.2)}
 QUICK_SCENES = {'slow': (200, 0.01, 0.25), 'fast': (60, 0.05, 0.2)}
@@ -158,8 +164,10 @@ def make_engine(pfv, solver=3, tol=1e-6, interval=1, def_tol=0.0, background=Fal
     if ref_tol is not None:
         e.refinement_tolerance = ref_tol
     e.viscosity = VISCOSITY
-    e.solver = {0: 'gauss_seidel', 1: 'conjugate_gradient', 3: 'cholesky'}[solver]
+    e.solver = {0: 'gauss_seidel', 1: 'conjugate_gradient', 3: 'cholesky', MULTIGRID: 'multigrid'}[solver]
     e.tolerance = tol
+    if solver == MULTIGRID:  # its stopping rule is the refinement's, relative to the pressure spread
+        e.refinement_tolerance = tol
     e.mesh_update_interval = interval
     e.def_tolerance = def_tol
     e.background_remesh = background
@@ -169,7 +177,7 @@ def make_engine(pfv, solver=3, tol=1e-6, interval=1, def_tol=0.0, background=Fal
 
 
 def solver_name(s):
-    return {0: 'GS', 1: 'PCG', 3: 'CHOLMOD'}[s]
+    return {0: 'GS', 1: 'PCG', 3: 'CHOLMOD', MULTIGRID: 'AMG-PCG'}[s]
 
 
 def perm_configs(quick):
@@ -180,6 +188,7 @@ def perm_configs(quick):
                   ref_tol=1e-6)]
     cfgs += [dict(name=f'GS {t:.0e}', family='GS', solver=0, tol=t) for t in tols]
     cfgs += [dict(name=f'PCG {t:.0e}', family='PCG', solver=1, tol=t) for t in tols]
+    cfgs += [dict(name=f'AMG-PCG {t:.0e}', family='AMG-PCG', solver=MULTIGRID, tol=t) for t in AMG_TOLS]
     return cfgs
 
 
@@ -196,6 +205,8 @@ def oedo_configs(scene, n, quick):
     for s in (0, 1):
         c += [dict(name=f'{solver_name(s)} {t:.0e}, interval {si}', family=solver_name(s), solver=s, tol=t,
                    interval=si) for t in tols[s]]
+    c += [dict(name=f'AMG-PCG {t:.0e}, interval {si}', family='AMG-PCG', solver=MULTIGRID, tol=t, interval=si)
+          for t in AMG_TOLS[1::2]]
     c += [dict(name='CHOLMOD mixed precision, interval 10', family='mixed', solver=3, interval=10, mixed=True),
           dict(name='CHOLMOD mixed precision, refinement 1e-06, interval 10', family='mixed', solver=3, interval=10,
                mixed=True, ref_tol=1e-6),
@@ -340,7 +351,7 @@ def run_oedo(pfv, scene, n, work, quick):
         return (c['interval'], c.get('def_tol', 0.0))
     by_schedule = {schedule(c): j for j, c in enumerate(cfgs) if c['family'] in ('interval', 'defTolerance', 'reference')}
     for j, c in enumerate(cfgs):
-        if c['family'] in ('GS', 'PCG', 'mixed') and schedule(c) in by_schedule:
+        if c['family'] in ('GS', 'PCG', 'AMG-PCG', 'mixed') and schedule(c) in by_schedule:
             b = by_schedule[schedule(c)]
             out[j]['e_base_same_mesh'] = float(np.sqrt(np.mean((base[j] - base[b]) ** 2)) / pb)
     return dict(scene=scene, n=n, steps=steps, eps_f=eps_f, tau=tau, max_strain_rate_per_step=strain_max,
@@ -446,7 +457,7 @@ def figure(parts, path):
               ('slow', None, 'oedometer, slow consolidation', 'e_base (RMS / peak base pressure)'),
               ('fast', None, 'oedometer, fast deformation', 'e_base (RMS / peak base pressure)')]
     colours = {'CHOLMOD': 'k', 'reference': 'k', 'GS': 'tab:blue', 'PCG': 'tab:orange', 'interval': 'tab:green',
-               'defTolerance': 'tab:red', 'background': 'tab:purple', 'mixed': 'tab:brown'}
+               'defTolerance': 'tab:red', 'background': 'tab:purple', 'mixed': 'tab:brown', 'AMG-PCG': 'tab:cyan'}
     sizes = sorted({p['n'] for p in parts})
     markers = ['o', 's', '^', 'D']
     fig, axes = plt.subplots(2, 2, figsize=(11, 8))
@@ -488,6 +499,7 @@ def figure(parts, path):
     handles[4] = plt.Line2D([], [], marker='o', ls='', color=colours['defTolerance'], label='CHOLMOD, defTolerance')
     handles[5] = plt.Line2D([], [], marker='o', ls='', color=colours['background'], label='CHOLMOD, background remesh')
     handles[6] = plt.Line2D([], [], marker='o', ls='', color=colours['mixed'], label='CHOLMOD, mixed precision')
+    handles[7] = plt.Line2D([], [], marker='o', ls='', color=colours['AMG-PCG'], label='CG + BoomerAMG (multigrid)')
     fig.legend(handles=handles, loc='lower center', ncol=4, fontsize=8)
     fig.tight_layout(rect=(0, 0.07, 1, 1))
     os.makedirs(os.path.dirname(path), exist_ok=True)

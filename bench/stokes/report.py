@@ -88,8 +88,8 @@ def convergence_table(results):
             s, n = lv["symmetry"], lv["noslip"]
             cs = "" if prev is None else "%+.2f %%" % (100 * (s["kappa"] / prev[0] - 1))
             cn = "" if prev is None else "%+.2f %%" % (100 * (n["kappa"] / prev[1] - 1))
-            lines.append("| %s | %.3f | %d | %.4e | %s | %.4e | %s | %.0f / %.0f | %.1e / %.1e |" % (
-                r["case"], lv["surface"], s["dofs"], s["kappa"], cs, n["kappa"], cn,
+            lines.append("| %s | %.3f | %s | %.4e | %s | %.4e | %s | %.0f / %.0f | %.1e / %.1e |" % (
+                r["case"], lv["surface"], "{:,}".format(s["dofs"]).replace(",", " "), s["kappa"], cs, n["kappa"], cn,
                 s["seconds_solve"], n["seconds_solve"], balance(s), balance(n)))
             prev = (s["kappa"], n["kappa"])
         if len(r["fem"]) >= 3:

@@ -134,8 +134,11 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     metis_used_ = given.from_metis;
   }
   if (!ordering_given_) {
-    if (ordering == Ordering::kAuto) {
+    if (ordering == Ordering::kAuto && n < kMetisDirectFrom) {
       c->nmethods = 0;
+    } else if (ordering == Ordering::kAuto) {
+      c->nmethods = 1;
+      c->method[0].ordering = CHOLMOD_METIS;
     } else {
       c->nmethods = 1;
       c->method[0].ordering = ordering == Ordering::kAmd     ? CHOLMOD_AMD

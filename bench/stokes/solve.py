@@ -1,4 +1,5 @@
-"""Taylor-Hood (P2-P1) Stokes flow in the fluid mesh of mesh.py, solved by LU (MUMPS through PETSc).
+"""Taylor-Hood (P2-P1) Stokes flow in the fluid mesh of mesh.py, solved by LDL^T (MUMPS through PETSc) or,
+for meshes whose factor does not fit in memory, by preconditioned MINRES.
 
 Pressure dp on the face y = 0 and 0 on y = 1 (natural condition sigma.n = -p n, with
 sigma = -p I + 2 mu eps(u)); no-slip on the spheres; on the four lateral faces either no-slip or
@@ -7,6 +8,14 @@ the permeability kappa = mu Q l0 / (dp S) with S = l0^2 and Q their mean (l0 = 1
 kappa / l0^2), and
 the force of the fluid on every sphere and lateral face, split into its pressure and viscous
 parts.
+
+The iterative solve (method="minres") uses the block-diagonal preconditioner diag(A_u, M_p / mu) of the Stokes
+operator, which keeps the MINRES iteration count bounded independently of the mesh size (Elman, Silvester and
+Wathen, "Finite elements and fast iterative solvers", ch. 4): A_u the vector Laplacian mu grad u : grad v (spectrally
+equivalent to the strain-rate form by Korn's inequality, with the spheres' no-slip condition), approximated by one
+BoomerAMG V-cycle (hypre; the vector Laplacian does not couple the components, so
+unknown-based AMG coarsens each on its own), M_p the P1 pressure mass matrix, approximated by
+Jacobi. Its memory is that of the two assembled matrices and the AMG hierarchy, O(DOFs).
 """
 import time
 
@@ -23,7 +32,8 @@ LATERAL = (1, 2, 5, 6)  # xmin, xmax, zmin, zmax: the flow is along y
 INLET, OUTLET = 3, 4
 
 
-def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_tolerance=1e-10, symmetric=True):
+def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_tolerance=1e-10, symmetric=True,
+          method="direct", rtol=1e-10):
     start = time.perf_counter()
     cell = mesh.ufl_cell()
     element = ufl.MixedElement([ufl.VectorElement("Lagrange", cell, 2), ufl.FiniteElement("Lagrange", cell, 1)])
@@ -62,30 +72,23 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_toler
     fem.petsc.apply_lifting(b, [fem.form(a)], bcs=[bcs])
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     fem.petsc.set_bc(b, bcs)
-    ksp = PETSc.KSP().create(MPI.COMM_SELF)
-    ksp.setOperators(A)
-    ksp.setType("preonly")
-    pc = ksp.getPC()
-    if symmetric:
-        # The Stokes matrix is symmetric (indefinite): MUMPS' LDL^T stores one triangle.
-        A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        pc.setType("cholesky")
+    if method == "direct":
+        ksp = direct_solver(A, blr_tolerance, symmetric)
+        preconditioner = None
+    elif method == "minres":
+        ksp, preconditioner = minres_solver(W, A, bcs, mu, u, v, p, q, rtol)
     else:
-        pc.setType("lu")
-    pc.setFactorSolverType("mumps")
-    pc.setFactorSetUpSolverType()
-    if blr_tolerance > 0:
-        # MUMPS' block low-rank factorisation (ICNTL 35, dropping tolerance CNTL 7): on the
-        # 8-sphere packing at 165 000 DOFs it cuts the peak memory from 5.4 to 4.5 GB and the
-        # solve by a quarter; at 1e-10 it moves kappa and the forces by about 1e-10 relative.
-        pc.getFactorMatrix().setMumpsIcntl(35, 2)
-        pc.getFactorMatrix().setMumpsCntl(7, blr_tolerance)
+        raise ValueError("method must be 'direct' or 'minres'")
     w = fem.Function(W)
     assembled = time.perf_counter()
     ksp.solve(b, w.vector)
     w.x.scatter_forward()
     solved = time.perf_counter()
-    pc.reset()  # frees MUMPS' factor now, before the forces' forms are compiled and assembled
+    iterations = ksp.getIterationNumber()
+    if method == "minres" and ksp.getConvergedReason() <= 0:
+        raise RuntimeError("MINRES did not converge (reason %d after %d iterations)"
+                           % (ksp.getConvergedReason(), iterations))
+    ksp.getPC().reset()  # frees MUMPS' factor (or the AMG hierarchy) before the forces' forms are assembled
     uh, ph = w.split()
 
     def integral(expr):
@@ -119,7 +122,7 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_toler
             for key, form in zip(("pressure", "viscous"), forms):
                 parts[key].append(mesh.comm.allreduce(fem.assemble_scalar(form), op=MPI.SUM))
         forces[name] = parts
-    for obj in (ksp, A, b):
+    for obj in (ksp, A, b) + ((preconditioner,) if preconditioner is not None else ()):
         obj.destroy()
     return {
         "lateral": lateral,
@@ -130,5 +133,65 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_toler
         "cells": mesh.topology.index_map(3).size_global,
         "seconds_assembly": assembled - start,
         "seconds_solve": solved - assembled,
+        "solver": method,
+        "iterations": iterations,
         "forces": forces,
     }
+
+
+def direct_solver(A, blr_tolerance, symmetric):
+    ksp = PETSc.KSP().create(MPI.COMM_SELF)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    if symmetric:
+        # The Stokes matrix is symmetric (indefinite): MUMPS' LDL^T stores one triangle.
+        A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        pc.setType("cholesky")
+    else:
+        pc.setType("lu")
+    pc.setFactorSolverType("mumps")
+    pc.setFactorSetUpSolverType()
+    if blr_tolerance > 0:
+        # MUMPS' block low-rank factorisation (ICNTL 35, dropping tolerance CNTL 7): on the
+        # 8-sphere packing at 165 000 DOFs it cuts the peak memory from 5.4 to 4.5 GB and the
+        # solve by a quarter; at 1e-10 it moves kappa and the forces by about 1e-10 relative.
+        pc.getFactorMatrix().setMumpsIcntl(35, 2)
+        pc.getFactorMatrix().setMumpsCntl(7, blr_tolerance)
+    return ksp
+
+
+def minres_solver(W, A, bcs, mu, u, v, p, q, rtol):
+    """MINRES on the Stokes matrix A with the block-diagonal preconditioner of the module docstring."""
+    a_p = (mu * ufl.inner(ufl.grad(u), ufl.grad(v)) + (1.0 / mu) * p * q) * ufl.dx
+    P = fem.petsc.assemble_matrix(fem.form(a_p), bcs=bcs)
+    P.assemble()
+    _, u_dofs = W.sub(0).collapse()
+    _, p_dofs = W.sub(1).collapse()
+    is_u = PETSc.IS().createGeneral(np.sort(np.asarray(u_dofs, dtype=np.int32)), comm=MPI.COMM_SELF)
+    is_p = PETSc.IS().createGeneral(np.sort(np.asarray(p_dofs, dtype=np.int32)), comm=MPI.COMM_SELF)
+    ksp = PETSc.KSP().create(MPI.COMM_SELF)
+    ksp.setOperators(A, P)
+    ksp.setType("minres")
+    # PETSc's MINRES measures the preconditioned residual; rtol is relative to its initial value.
+    ksp.setTolerances(rtol=rtol, atol=0.0, max_it=5000)
+    pc = ksp.getPC()
+    pc.setType("fieldsplit")
+    pc.setFieldSplitIS(("u", is_u), ("p", is_p))
+    pc.setFieldSplitType(PETSc.PC.CompositeType.ADDITIVE)
+    opts = PETSc.Options()
+    opts["fieldsplit_u_ksp_type"] = "preonly"
+    opts["fieldsplit_u_pc_type"] = "hypre"
+    opts["fieldsplit_u_pc_hypre_type"] = "boomeramg"
+    opts["fieldsplit_u_pc_hypre_boomeramg_strong_threshold"] = 0.5
+    opts["fieldsplit_u_pc_hypre_boomeramg_coarsen_type"] = "HMIS"
+    opts["fieldsplit_u_pc_hypre_boomeramg_interp_type"] = "ext+i"
+    opts["fieldsplit_u_pc_hypre_boomeramg_P_max"] = 4
+    opts["fieldsplit_p_ksp_type"] = "preonly"
+    opts["fieldsplit_p_pc_type"] = "jacobi"
+    ksp.setFromOptions()
+    pc.setFromOptions()
+    pc.setUp()
+    for sub in pc.getFieldSplitSubKSP():
+        sub.setFromOptions()
+    return ksp, P

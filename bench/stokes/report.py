@@ -79,18 +79,20 @@ def balance(solution):
 
 
 def convergence_table(results):
-    lines = ["| case | surface size | DOFs | κ_FEM sym | change | κ_FEM no-slip | change | solve (s) sym / no-slip "
-             "| \\|Q_in − Q_out\\| / Q sym / no-slip |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| case | surface size | DOFs | folded cells | κ_FEM sym | change | κ_FEM no-slip | change "
+             "| solve (s) sym / no-slip | \\|Q_in − Q_out\\| / Q sym / no-slip |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         prev = None
         for lv in r["fem"]:
             s, n = lv["symmetry"], lv["noslip"]
             cs = "" if prev is None else "%+.2f %%" % (100 * (s["kappa"] / prev[0] - 1))
             cn = "" if prev is None else "%+.2f %%" % (100 * (n["kappa"] / prev[1] - 1))
-            lines.append("| %s | %.3f | %s | %.4e | %s | %.4e | %s | %.0f / %.0f | %.1e / %.1e |" % (
-                r["case"], lv["surface"], "{:,}".format(s["dofs"]).replace(",", " "), s["kappa"], cs, n["kappa"], cn,
-                s["seconds_solve"], n["seconds_solve"], balance(s), balance(n)))
+            folded = "%d of %s" % (lv["tangled_cells"], "{:,}".format(s["cells"]).replace(",", " ")) \
+                if "tangled_cells" in lv else "–"
+            lines.append("| %s | %.3f | %s | %s | %.4e | %s | %.4e | %s | %.0f / %.0f | %.1e / %.1e |" % (
+                r["case"], lv["surface"], "{:,}".format(s["dofs"]).replace(",", " "), folded, s["kappa"], cs,
+                n["kappa"], cn, s["seconds_solve"], n["seconds_solve"], balance(s), balance(n)))
             prev = (s["kappa"], n["kappa"])
         if len(r["fem"]) >= 3:
             cells = []
@@ -102,7 +104,7 @@ def convergence_table(results):
                     cells += ["–", "q = %.2f, pre-asymptotic" % order]
                 else:
                     cells += ["–", "no monotone order"]
-            lines.append("| %s | → 0 (Richardson) | | %s | %s | %s | %s | | |" % ((r["case"],) + tuple(cells)))
+            lines.append("| %s | → 0 (Richardson) | | | %s | %s | %s | %s | | |" % ((r["case"],) + tuple(cells)))
     return "\n".join(lines)
 
 

@@ -101,8 +101,9 @@ def build(packing, surface, layer=0.32, order=2, verbose=False):
             # Curving the edges onto the spheres tangles cells whose straight edges cut a narrow gap:
             # their Jacobian changes sign inside the cell (1-2 % of the cells at these sizes), which
             # breaks the flux balance between the two pressure faces (3e-3 on the 8-sphere packing,
-            # 3e-2 on 54 spheres) and moves the pressure / viscous split of the sphere forces by
-            # several per cent. gmsh's elastic untangling leaves under 0.1 % of the cells folded.
+            # 3e-2 on 54 spheres) and moves the pressure / viscous split of single sphere forces by
+            # tens of per cent on coarse meshes. gmsh's elastic untangling leaves under 0.1 % of the
+            # cells folded on 8 to 54 spheres.
             gmsh.model.mesh.optimize("HighOrderElastic")
         mesh, cells, facets = gmshio.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=3)
     finally:

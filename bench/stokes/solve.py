@@ -171,6 +171,11 @@ def minres_solver(W, A, bcs, mu, u, v, p, q, rtol):
     is_u = PETSc.IS().createGeneral(np.sort(np.asarray(u_dofs, dtype=np.int32)), comm=MPI.COMM_SELF)
     is_p = PETSc.IS().createGeneral(np.sort(np.asarray(p_dofs, dtype=np.int32)), comm=MPI.COMM_SELF)
     ksp = PETSc.KSP().create(MPI.COMM_SELF)
+    # The sub-solvers are configured through PETSc's options database under a prefix of this KSP (set
+    # before the splits are made, which inherit it), removed again once the solver is set up, so that
+    # nothing leaks into later solvers.
+    prefix = "stokes_minres_"
+    ksp.setOptionsPrefix(prefix)
     ksp.setOperators(A, P)
     ksp.setType("minres")
     # PETSc's MINRES measures the preconditioned residual; rtol is relative to its initial value.
@@ -179,19 +184,18 @@ def minres_solver(W, A, bcs, mu, u, v, p, q, rtol):
     pc.setType("fieldsplit")
     pc.setFieldSplitIS(("u", is_u), ("p", is_p))
     pc.setFieldSplitType(PETSc.PC.CompositeType.ADDITIVE)
+    settings = {"fieldsplit_u_ksp_type": "preonly", "fieldsplit_u_pc_type": "hypre",
+                "fieldsplit_u_pc_hypre_type": "boomeramg", "fieldsplit_u_pc_hypre_boomeramg_strong_threshold": 0.5,
+                "fieldsplit_u_pc_hypre_boomeramg_coarsen_type": "HMIS",
+                "fieldsplit_u_pc_hypre_boomeramg_interp_type": "ext+i", "fieldsplit_u_pc_hypre_boomeramg_P_max": 4,
+                "fieldsplit_p_ksp_type": "preonly", "fieldsplit_p_pc_type": "jacobi"}
     opts = PETSc.Options()
-    opts["fieldsplit_u_ksp_type"] = "preonly"
-    opts["fieldsplit_u_pc_type"] = "hypre"
-    opts["fieldsplit_u_pc_hypre_type"] = "boomeramg"
-    opts["fieldsplit_u_pc_hypre_boomeramg_strong_threshold"] = 0.5
-    opts["fieldsplit_u_pc_hypre_boomeramg_coarsen_type"] = "HMIS"
-    opts["fieldsplit_u_pc_hypre_boomeramg_interp_type"] = "ext+i"
-    opts["fieldsplit_u_pc_hypre_boomeramg_P_max"] = 4
-    opts["fieldsplit_p_ksp_type"] = "preonly"
-    opts["fieldsplit_p_pc_type"] = "jacobi"
+    for key, value in settings.items():
+        opts[prefix + key] = value
     ksp.setFromOptions()
-    pc.setFromOptions()
     pc.setUp()
-    for sub in pc.getFieldSplitSubKSP():
-        sub.setFromOptions()
+    for key in settings:
+        opts.delValue(prefix + key)
+    for index_set in (is_u, is_p):
+        index_set.destroy()
     return ksp, P

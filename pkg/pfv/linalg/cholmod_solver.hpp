@@ -26,9 +26,9 @@ struct SupernodalChains {
 enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
 
 // From this many unknowns kAuto skips CHOLMOD's AMD trial, whose result it would discard: on the
-// jittered-lattice benchmark systems METIS's factor needs 2.6 (5 700 unknowns) to 8 (325 000)
-// times fewer flops than AMD's, so CHOLMOD's default orders twice and keeps METIS. Below this
-// size AMD's cheaper analysis can win overall, and CHOLMOD's rule is kept.
+// benchmark packings AMD's factor has about twice METIS's entries from 10 000 spheres (57 000
+// unknowns) on, so CHOLMOD's default orders twice and keeps METIS. Below this size AMD's cheaper
+// analysis can win overall, and CHOLMOD's rule is kept.
 inline constexpr int kMetisDirectFrom = 20000;
 
 // kScaled32 keeps the factor, computed in double, as 32-bit integers with one double scale per

@@ -1,6 +1,6 @@
 """Stage measurements behind doc/benchmarks.md (stage measurements) and doc/solvers.md, on the cached benchmark packing (made by bench/flow_benchmark.py).
 
-    yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6]
+    yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6,7]
 
 1. ordering reuse: CHOLMOD analysis with a fresh METIS ordering and with the ordering carried over from the previous
    mesh, for the same positions and after moving every sphere at random by 0.5 % and 2 % of the mean radius
@@ -17,7 +17,11 @@
    runs them on the calling thread (`flow.core.cholmod_openmp_teams`), and the page faults of each remesh step
    (getrusage: the factor's storage is reused from the second mesh on);
 6. the collective viscous limit of a first mesh (drained top, viscosity 10, density 2600): the engine's Arnoldi
-   (at most 40 operator applications) against power iteration from the same fixed start, 40 and 120 iterations.
+   (at most 40 operator applications) against power iteration from the same fixed start, 40 and 120 iterations;
+7. the first ordering against the size (the threshold kMetisDirectFrom of ordering="auto"): sub-cubes of the packing
+   of about 1 000 to 32 000 spheres and the whole packing, each ordered by AMD alone, METIS alone and CHOLMOD's rule
+   (ordering="cholmod": AMD, then METIS if AMD fills badly, the better kept; what "auto" does below the threshold):
+   analysis and factorisation times, nnz(L), the solve, and which ordering the rule keeps.
 Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers;
 section 2 imitates the DEM's eviction of the factor).
 """
@@ -207,6 +211,40 @@ def collective_limit(pos, rad, walls):
           'power-39 / Arnoldi - 1 = %.2g' % (arnoldi, t_arnoldi, power[12], t_power, power[-1], power[12] / arnoldi - 1))
 
 
+def ordering_threshold(pos, rad, L, repeats=3):
+    """Section 7: the first ordering of sub-cubes of the packing, AMD alone, METIS alone and CHOLMOD's rule."""
+    print('7. first ordering against the size (medians of %d fresh engines each; the solve: the double factor)'
+          % repeats)
+    print('   %8s %8s | %-38s | %-38s | %-24s' % ('spheres', 'unknowns', 'AMD: analysis, factor, nnz(L), solve',
+                                                  'METIS: analysis, factor, nnz(L), solve',
+                                                  "CHOLMOD's rule: analysis, kept"))
+    for target in (1000, 2000, 3000, 4000, 8000, 16000, 32000, 64000):
+        if target > 1.2 * len(rad):
+            break
+        side = L * min(1.0, target / len(rad)) ** (1.0 / 3.0)
+        inside = np.all(pos - rad[:, None] >= 0, axis=1) & np.all(pos + rad[:, None] <= side, axis=1)
+        p, r, walls = pos[inside].copy(), rad[inside].copy(), [0, side, 0, side, 0, side]
+        row = {}
+        for name in ('amd', 'metis', 'cholmod'):
+            runs = []
+            for _ in range(repeats):
+                e = engine()
+                e.ordering = name
+                e.step(p, r, walls, 1e-4)
+                t = e.remesh_times()
+                e.step(p, r, walls, 1e-4)
+                runs.append((t['analysis'], t['factorization'], e.factor_nonzeros(), e.step_times()['solve'],
+                             e.metis_used()))
+                unknowns = e.n_unknowns()
+            row[name] = [float(np.median([x[k] for x in runs])) for k in range(4)] + [{x[4] for x in runs}]
+        kept = '/'.join(sorted('METIS' if m else 'AMD' for m in row['cholmod'][4]))
+        print('   %8d %8d | %7.3f s %7.3f s %8.3g %6.2f ms | %7.3f s %7.3f s %8.3g %6.2f ms | %7.3f s  %s'
+              % (len(r), unknowns, *row['amd'][:3], 1e3 * row['amd'][3], *row['metis'][:3], 1e3 * row['metis'][3],
+                 row['cholmod'][0], kept))
+    print('   ordering="auto" is CHOLMOD\'s rule below %d unknowns and METIS alone from there on'
+          % pfv.Engine.metis_direct_from)
+
+
 def main():
     n = option('size', 10000)
     spheres, meta = fb.read_packing(n)
@@ -215,7 +253,7 @@ def main():
     L = meta.get('box', fb.box_side(n))
     walls = [0, L, 0, L, 0, L]
     print('solver_stages: N = %d, packing %s' % (n, fb.packing_path(n)))
-    sections = option('sections', '1,2,3,4,5,6').split(',')
+    sections = option('sections', '1,2,3,4,5,6,7').split(',')
     if '1' in sections:
         ordering(pos, rad, walls)
     if '2' in sections:
@@ -224,6 +262,8 @@ def main():
         exchange(pos, rad, L)
     if '6' in sections:
         collective_limit(pos, rad, walls)
+    if '7' in sections:
+        ordering_threshold(pos, rad, L)
     if '5' in sections:
         remesh_sequence(n)
     return 0

@@ -2,8 +2,12 @@
 """The half-wavelength sinusoid with a ramped amplitude (thesis sections 6.2-6.3), dense and loose:
 p_top = A(t) (1 + cos(pi x / L)), A(t) = rate t.
 
-    yade-double -n -x examples/wave_ramp.py [--quick] [--rate=100] [--duration=20] [--out=DIR]
+    yade-double -n -x examples/wave_ramp.py [--quick] [--rate=100] [--duration=20] [--out=DIR] [--bed=dense|loose]
     yade-double -n -x examples/wave_ramp.py --from=DIR     (the criterion again on the records in DIR)
+
+--bed runs one of the two beds only (two processes run the beds side by side on two cores, each
+with its own --duration: the loose bed fails at a fraction of the dense bed's amplitude); --from
+then reads both records from DIR.
 
 Both samples (phi_c1 = 1 and 30 deg; phi_c2 = 30 deg) under the same ramp. A sample becomes unstable
 at the amplitude where the root-mean-square grain velocity sqrt(2 KE / M) first exceeds 1 % of
@@ -53,11 +57,16 @@ def sample_mass(sample):
     return sum(4 / 3 * math.pi * s[3] ** 3 * rho for s in sample["spheres"])
 
 
-o = seabed_wave.options(sys.argv[1:], dict(rate=100.0, duration=20.0, out="wave-ramp", **{"from": ""}))
+o = seabed_wave.options(sys.argv[1:], dict(rate=100.0, duration=20.0, out="wave-ramp", bed="", **{"from": ""}))
 folder = o["from"] or o["out"]
 num = 1000 if o["quick"] else 5000
+BEDS = (("dense", 1.0), ("loose", 30.0))
+if o["bed"] and (o["from"] or o["bed"] not in dict(BEDS)):
+    raise SystemExit(f"--bed={o['bed']}: expected dense or loose, and not with --from")
 unstable = {}
-for name, friction in (("dense", 1.0), ("loose", 30.0)):
+for name, friction in BEDS:
+    if o["bed"] and name != o["bed"]:
+        continue
     if o["from"]:
         with open(os.path.join(folder, name, "summary.json")) as f:
             num = json.load(f)["grains"]
@@ -73,6 +82,8 @@ for name, friction in (("dense", 1.0), ("loose", 30.0)):
     unstable[name] = instability_amplitudes(*record, sample_mass(sample), sample["grains"]["d50"])
     print(f"{name} (n = {sample['porosity']:.3f}): unstable at A = {unstable[name][CRITERION]:.0f} Pa "
           f"(thresholds {', '.join(f'{100 * f:g} %: {a:.0f} Pa' for f, a in unstable[name].items())})")
+if o["bed"]:
+    sys.exit(0)  # one bed: the ratio comes from --from=DIR once both records are there
 ratios = {f: unstable["dense"][f] / unstable["loose"][f] for f in THRESHOLDS}
 print(f"instability amplitude dense / loose = {ratios[CRITERION]:.2f} (thesis: about 4; thresholds "
       f"{', '.join(f'{100 * f:g} %: {r:.2f}' for f, r in ratios.items())})")

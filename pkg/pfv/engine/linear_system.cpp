@@ -50,6 +50,7 @@ bool ordering_fits(const CellOrdering& previous, Ordering wanted) {
     case Ordering::kAmd:
       return !previous.from_metis();
     case Ordering::kAuto:
+    case Ordering::kCholmod:
       break;
   }
   return true;

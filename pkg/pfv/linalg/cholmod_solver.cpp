@@ -134,7 +134,7 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     metis_used_ = given.from_metis;
   }
   if (!ordering_given_) {
-    if (ordering == Ordering::kAuto && n < kMetisDirectFrom) {
+    if (ordering == Ordering::kCholmod || (ordering == Ordering::kAuto && n < kMetisDirectFrom)) {
       c->nmethods = 0;
     } else if (ordering == Ordering::kAuto) {
       c->nmethods = 1;

@@ -21,14 +21,15 @@ struct SupernodalChains {
   std::vector<int> chain_end, parent;
 };
 
-// Fill-reducing ordering. kAuto: CHOLMOD's default (AMD, then METIS if AMD fills badly) below
-// kMetisDirectFrom unknowns, METIS alone from there on.
-enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection };
+// Fill-reducing ordering. kCholmod: CHOLMOD's default rule (AMD, then METIS if AMD fills badly,
+// the better kept); kAuto: that rule below kMetisDirectFrom unknowns, METIS alone from there on.
+enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection, kCholmod };
 
 // From this many unknowns kAuto skips CHOLMOD's AMD trial, whose result it would discard: on the
 // benchmark packings AMD's factor has about twice METIS's entries from 10 000 spheres (57 000
 // unknowns) on, so CHOLMOD's default orders twice and keeps METIS. Below this size AMD's cheaper
-// analysis can win overall, and CHOLMOD's rule is kept.
+// analysis can win overall, and CHOLMOD's rule is kept. bench/solver_stages.py section 7 measures
+// both orderings and the rule against the size.
 inline constexpr int kMetisDirectFrom = 20000;
 
 // kScaled32 keeps the factor, computed in double, as 32-bit integers with one double scale per

@@ -199,16 +199,18 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&EngineSettings::max_iterations))
       .def_property("force_metis", get_setting(&EngineSettings::force_metis), set_setting(&EngineSettings::force_metis))
       .def_property("ordering", exclusive([](const SharedEngine& e) {
-                      const char* names[] = {"auto", "amd", "metis", "nesdis"};
+                      const char* names[] = {"auto", "amd", "metis", "nesdis", "cholmod"};
                       return std::string(names[static_cast<int>(e.settings.ordering)]);
                     }),
                     exclusive([](SharedEngine& e, const std::string& v) {
                       const std::map<std::string, Ordering> names{{"auto", Ordering::kAuto},
                                                                   {"amd", Ordering::kAmd},
                                                                   {"metis", Ordering::kMetis},
-                                                                  {"nesdis", Ordering::kNestedDissection}};
+                                                                  {"nesdis", Ordering::kNestedDissection},
+                                                                  {"cholmod", Ordering::kCholmod}};
                       const auto it = names.find(v);
-                      if (it == names.end()) throw py::value_error("ordering must be one of auto, amd, metis, nesdis");
+                      if (it == names.end())
+                        throw py::value_error("ordering must be one of auto, amd, metis, nesdis, cholmod");
                       update(e, [&](EngineSettings& s) { s.ordering = it->second; });
                     }))
       .def_property("mixed_precision", get_setting(&EngineSettings::mixed_precision),
@@ -224,6 +226,11 @@ PYBIND11_MODULE(_core, m) {
       .def("ordering_reused",
            exclusive([](const SharedEngine& e) { return e.cholesky() && e.cholmod().ordering_given(); }))
       .def("factor_fill", exclusive([](const SharedEngine& e) { return e.cholesky() ? e.cholmod().fill() : 0.0; }))
+      .def("n_unknowns", exclusive([](const SharedEngine& e) { return e.has_mesh() ? e.system().n_unknowns() : 0; }),
+           "Unknown pressures of the current system (cells not imposed); 0 before the first step.")
+      .def_property_readonly_static(
+          "metis_direct_from", [](const py::object&) { return kMetisDirectFrom; },
+          "Unknowns from which ordering='auto' orders by METIS alone (below: CHOLMOD's rule, AMD then METIS).")
       .def("reduced_precision_factor",
            exclusive([](const SharedEngine& e) { return e.cholesky() && e.cholmod().reduced_precision(); }))
       .def("refinement_contraction", exclusive(&FlowEngine::refinement_contraction))

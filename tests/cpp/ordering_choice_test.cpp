@@ -1,0 +1,47 @@
+// ordering = kAuto against CHOLMOD's own rule (kCholmod): the same factor on both sides of
+// kMetisDirectFrom, so that skipping the AMD trial from there on changes the cost of the
+// analysis only, never the ordering kept.
+#include <gtest/gtest.h>
+
+#include "pfv/engine/flow_engine.hpp"
+#include "test_packings.hpp"
+
+using namespace pfv;
+
+namespace {
+
+struct Outcome {
+  int unknowns;
+  double nonzeros;
+  bool metis;
+};
+
+Outcome first_factor(const test::TestPacking& p, Ordering ordering) {
+  FlowEngine e = test::permeameter(1);
+  e.settings.ordering = ordering;
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  return {e.system().n_unknowns(), e.cholmod().factor_nonzeros(), e.cholmod().metis_used()};
+}
+
+}  // namespace
+
+TEST(OrderingChoice, AutoIsCholmodsRuleBelowTheThreshold) {
+  const auto p = test::random_packing(600, 12);
+  const Outcome automatic = first_factor(p, Ordering::kAuto), rule = first_factor(p, Ordering::kCholmod);
+  ASSERT_LT(automatic.unknowns, kMetisDirectFrom);
+  EXPECT_EQ(automatic.nonzeros, rule.nonzeros);
+  EXPECT_EQ(automatic.metis, rule.metis);
+  EXPECT_FALSE(rule.metis);  // at this size CHOLMOD keeps AMD
+}
+
+TEST(OrderingChoice, AboveTheThresholdCholmodsRuleKeepsMetisAsAutoDoes) {
+  // About 6 unknowns per sphere: 4 000 spheres are above kMetisDirectFrom.
+  const auto p = test::random_packing(4000, 13, 0.02, 0.03);
+  const Outcome automatic = first_factor(p, Ordering::kAuto), rule = first_factor(p, Ordering::kCholmod);
+  const Outcome amd = first_factor(p, Ordering::kAmd);
+  ASSERT_GE(automatic.unknowns, kMetisDirectFrom);
+  EXPECT_TRUE(automatic.metis);
+  EXPECT_TRUE(rule.metis);  // CHOLMOD tried AMD, then METIS, and discarded AMD's ordering
+  EXPECT_EQ(automatic.nonzeros, rule.nonzeros);
+  EXPECT_GT(amd.nonzeros, 1.3 * rule.nonzeros);  // why: AMD's factor is much larger at this size
+}

@@ -4,10 +4,14 @@
 #include <CGAL/Regular_triangulation_3.h>
 #include <CGAL/Regular_triangulation_cell_base_3.h>
 #include <CGAL/Regular_triangulation_vertex_base_3.h>
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <CGAL/property_map.h>
+#include <CGAL/spatial_sort.h>
 
 #include <algorithm>
+#include <numeric>
 #include <utility>
 
 namespace pfv {
@@ -102,15 +106,47 @@ const Mesh& RegularTriangulation::build(const std::vector<Vec3>& centres, const 
   return mesh_;
 }
 
+namespace {
+
+// Boundary cells reach the far-away wall spheres; only their part inside the box is a pore.
+bool inside(const BoxWalls& walls, const Vec3& x) {
+  for (int w = 0; w < kWallCount; ++w)
+    if (!(walls.height(w, x) >= 0)) return false;
+  return true;
+}
+
+}  // namespace
+
 int RegularTriangulation::locate(const Vec3& x) const {
   const RT& rt = impl_->rt;
-  if (rt.dimension() < 3) return -1;
-  // Boundary cells reach the far-away wall spheres; only their part inside the box is a pore.
-  for (int w = 0; w < kWallCount; ++w)
-    if (!(walls_.height(w, x) >= 0)) return -1;
+  if (rt.dimension() < 3 || !inside(walls_, x)) return -1;
   const auto c = rt.locate(WPoint(K::Point_3(x.x(), x.y(), x.z()), 0.0));
   if (rt.is_infinite(c)) return -1;
   return c->info();
+}
+
+std::vector<int> RegularTriangulation::locate_all(const std::vector<Vec3>& points) const {
+  const RT& rt = impl_->rt;
+  const int n = static_cast<int>(points.size());
+  std::vector<int> cells(n, -1);
+  if (rt.dimension() < 3) return cells;
+  std::vector<K::Point_3> p;
+  p.reserve(n);
+  for (const Vec3& x : points) p.emplace_back(x.x(), x.y(), x.z());
+  std::vector<std::size_t> order(n);  // the adapter's key type
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  using Traits = CGAL::Spatial_sort_traits_adapter_3<K, decltype(CGAL::make_property_map(p))>;
+  CGAL::spatial_sort(order.begin(), order.end(), Traits(CGAL::make_property_map(p)));
+  RT::Cell_handle hint;  // none: CGAL starts from a cell of its choice
+  for (const std::size_t i : order) {
+    const Vec3& x = points[i];
+    if (!inside(walls_, x)) continue;
+    const auto c = rt.locate(WPoint(p[i], 0.0), hint);
+    if (rt.is_infinite(c)) continue;
+    hint = c;
+    cells[i] = c->info();
+  }
+  return cells;
 }
 
 std::vector<std::pair<int, int>> RegularTriangulation::centres_inside_neighbours(

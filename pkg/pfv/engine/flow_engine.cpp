@@ -258,9 +258,11 @@ bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditio
   const int n = m.mesh().n_cells();
   const std::vector<double> no_radii;
   const Packing packing{centres, no_radii, walls};
+  std::vector<Vec3> barycentres(n);  // inside the new cell (a power centre need not be)
+  for (int k = 0; k < n; ++k) barycentres[k] = cell_barycenter(m.cells.shape[k], packing);
+  const std::vector<int> located = mesh_->tri.locate_all(barycentres);
   for (int k = 0; k < n; ++k) {
-    // The barycentre lies inside the new cell (a power centre need not).
-    const int old = mesh_->tri.locate(cell_barycenter(m.cells.shape[k], packing));
+    const int old = located[k];
     if (old < 0 || !cells_.is_blocked(old)) continue;
     carried |= conditions.block(k, n);
     conditions.set_pressure(k, cells_.pressure_of(old), n);
@@ -280,11 +282,13 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& 
   // unless asked for: interpolate_on_remesh.)
   std::vector<double> pressure(mesh.mesh().n_cells(), settings.p_zero);
   const bool interpolated = settings.interpolates() && has_mesh();
-  if (interpolated)
-    for (int c = 0; c < mesh.mesh().n_cells(); ++c) {
-      const int old = mesh_->tri.locate(mesh.cells.power_centre[c]);
-      if (old >= 0) pressure[c] = pressure_[old];
-    }
+  const auto t0 = std::chrono::steady_clock::now();
+  if (interpolated) {
+    const std::vector<int> located = mesh_->tri.locate_all(mesh.cells.power_centre);
+    for (int c = 0; c < mesh.mesh().n_cells(); ++c)
+      if (located[c] >= 0) pressure[c] = pressure_[located[c]];
+  }
+  const double carry_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // A cell blocked at zero pressure holds zero (a flat cell, or one carried over, keeps its pressure).
   for (int c = 0; c < mesh.mesh().n_cells(); ++c)
     if (conditions.is_blocked(c) && conditions.pressure_of(c) == CellPressure::kImposed) pressure[c] = 0;
@@ -296,6 +300,7 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& 
   t.assembly = linear.times.assembly;
   t.analysis = linear.times.analysis;
   t.factorization = linear.times.factorization;
+  t.carry_over = carry_seconds;
   remesh_times_ = t;
   mesh_ = std::make_unique<PoreMesh>(std::move(mesh));
   linear_ = std::move(linear);

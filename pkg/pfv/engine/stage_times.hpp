@@ -8,7 +8,8 @@ struct StageTimes {
   double force_cache = 0, volumes = 0, solve = 0, forces = 0;
   double shear_geometry = 0, shear_forces = 0;  // zero while viscous_shear is off
   double pressure_field = 0;                    // the call of FlowEngine::pressure_field (zero without)
-  double total = 0;  // the whole FlowEngine::step (step_times only), remesh included if it remeshed
+  double carry_over = 0;  // remesh: the old pressures located at the new cells (zero unless interpolating)
+  double total = 0;       // the whole FlowEngine::step (step_times only), remesh included if it remeshed
 };
 
 }  // namespace pfv

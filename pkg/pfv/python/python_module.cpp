@@ -42,6 +42,7 @@ py::dict times_dict(const StageTimes& t) {
   d["shear_geometry"] = t.shear_geometry;
   d["shear_forces"] = t.shear_forces;
   d["pressure_field"] = t.pressure_field;
+  d["carry_over"] = t.carry_over;
   d["total"] = t.total;
   return d;
 }

@@ -15,7 +15,8 @@ from typing import Any
 _REMESH_STAGES = (("triangulation", "remesh: triangulation"), ("geometry", "remesh: pore geometry"),
                   ("conductance", "remesh: conductances"), ("force_cache", "remesh: force cache"),
                   ("shear_geometry", "remesh: shear pairs"), ("assembly", "system: assembly"),
-                  ("analysis", "system: ordering"), ("factorization", "system: factorization"))
+                  ("analysis", "system: ordering"), ("factorization", "system: factorization"),
+                  ("carry_over", "remesh: pressures carried over"))
 _STEP_STAGES = (("volumes", "dV/dt"), ("pressure_field", "boundary pressure"), ("solve", "solve"), ("forces", "forces"),
                 ("shear_forces", "shear forces"))
 

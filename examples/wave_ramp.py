@@ -7,7 +7,7 @@ p_top = A(t) (1 + cos(pi x / L)), A(t) = rate t.
 
 --bed runs one of the two beds only (two processes run the beds side by side on two cores, each
 with its own --duration: the loose bed fails at a fraction of the dense bed's amplitude); --from
-then reads both records from DIR.
+then reads both records from DIR (with --bed, that bed's only).
 
 Both samples (phi_c1 = 1 and 30 deg; phi_c2 = 30 deg) under the same ramp. A sample becomes unstable
 at the amplitude where the root-mean-square grain velocity sqrt(2 KE / M) first exceeds 1 % of
@@ -61,8 +61,8 @@ o = seabed_wave.options(sys.argv[1:], dict(rate=100.0, duration=20.0, out="wave-
 folder = o["from"] or o["out"]
 num = 1000 if o["quick"] else 5000
 BEDS = (("dense", 1.0), ("loose", 30.0))
-if o["bed"] and (o["from"] or o["bed"] not in dict(BEDS)):
-    raise SystemExit(f"--bed={o['bed']}: expected dense or loose, and not with --from")
+if o["bed"] and o["bed"] not in dict(BEDS):
+    raise SystemExit(f"--bed={o['bed']}: expected dense or loose")
 unstable = {}
 for name, friction in BEDS:
     if o["bed"] and name != o["bed"]:

@@ -142,6 +142,7 @@ def trial(kind, steady):
     if kind != "yade":
         rec["solver_choice"] = flow.core.solver_choice
         rec["cg_iterations"] = flow.core.cg_iterations
+        rec["remesh_times"] = dict(flow.core.remesh_times())  # the forced remesh's stages (JSON only)
     del flow
     remove_flows()
     return rec

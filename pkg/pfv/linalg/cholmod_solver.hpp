@@ -25,12 +25,13 @@ struct SupernodalChains {
 // the better kept); kAuto: that rule below kMetisDirectFrom unknowns, METIS alone from there on.
 enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection, kCholmod };
 
-// From this many unknowns kAuto skips CHOLMOD's AMD trial, whose result it would discard: on the
-// benchmark packings AMD's factor has about twice METIS's entries from 10 000 spheres (57 000
-// unknowns) on, so CHOLMOD's default orders twice and keeps METIS. Below this size AMD's cheaper
-// analysis can win overall, and CHOLMOD's rule is kept. bench/solver_stages.py section 7 measures
-// both orderings and the rule against the size.
-inline constexpr int kMetisDirectFrom = 20000;
+// From this many unknowns kAuto orders by METIS alone. On sub-cubes of the benchmark packing
+// (bench/solver_stages.py section 7) METIS's factor has 0.6-0.7 x AMD's entries from 8 000
+// unknowns on and its solve is 1.3-1.6 x faster, so its extra analysis is repaid within a few
+// hundred steps, and later remeshes carry the order over; CHOLMOD's own rule keeps AMD up to
+// about 20 000 unknowns and from there orders twice to keep METIS. Below this size the two
+// factors solve alike and CHOLMOD's rule, with AMD's cheaper analysis, is kept.
+inline constexpr int kMetisDirectFrom = 8000;
 
 // kScaled32 keeps the factor, computed in double, as 32-bit integers with one double scale per
 // column (in CHOLMOD's array): L(i, j) ~ q(i, j) * max_i |L(i, j)| / (2^31 - 1). Half the memory

@@ -26,8 +26,8 @@ struct SupernodalChains {
 enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection, kCholmod };
 
 // From this many unknowns kAuto orders by METIS alone. On sub-cubes of the benchmark packing
-// (bench/solver_stages.py section 7) METIS's factor has 0.6-0.7 x AMD's entries from 8 000
-// unknowns on and its solve is 1.3-1.6 x faster, so its extra analysis is repaid within a few
+// (bench/solver_stages.py section 7) METIS's factor has at most 0.7 x AMD's entries from 8 000
+// unknowns on and its solve is 1.3 x faster or more, so its extra analysis is repaid within a few
 // hundred steps, and later remeshes carry the order over; CHOLMOD's own rule keeps AMD up to
 // about 20 000 unknowns and from there orders twice to keep METIS. Below this size the two
 // factors solve alike and CHOLMOD's rule, with AMD's cheaper analysis, is kept.

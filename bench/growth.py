@@ -265,6 +265,18 @@ def report(data, command):
     if fits:
         L += ["Fitted exponents a of cost ∝ N^a (least squares on log–log over the sizes measured):", "",
               "| engine | N | first step | remesh | flow step | peak RSS |", "|---|---|---|---|---|---|"] + fits + [""]
+    stages = [(t["n"], kind, tr["remesh_times"]) for t in data["timing"] if not t.get("failed")
+              for kind, tr in t["trials"].items() if "remesh_times" in tr]
+    if stages:
+        keys = ("triangulation", "geometry", "conductance", "force_cache", "assembly", "analysis", "factorization",
+                "carry_over")
+        L += ["PFV's forced remesh by stage (`remesh_times()` after the remesh window) [s]; the rest of the window is "
+              "the first solves on the new mesh, the time-step guard and the exchange with YADE:", "",
+              "| N | engine | " + " | ".join(k.replace("_", " ") for k in keys) + " |",
+              "|---|---|" + "---|" * len(keys)]
+        for n, kind, st in sorted(stages, key=lambda x: (x[0], KINDS.index(x[1]))):
+            L.append(f"| {size(n)} | {kind} | " + " | ".join(f"{st.get(k, 0.0):.2f}" for k in keys) + " |")
+        L.append("")
     failed = [c for c in data["timing"] + data["memory"] if c.get("failed")]
     for c in failed:
         L.append(f"Child `{' '.join(c['args'])}` failed (exit {c['returncode']}): `{c['tail'].splitlines()[-1][:200]}`")

@@ -281,7 +281,9 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& 
   // start of the iterative solvers. (The direct solve of an incompressible fluid needs neither,
   // unless asked for: interpolate_on_remesh.)
   std::vector<double> pressure(mesh.mesh().n_cells(), settings.p_zero);
-  const bool interpolated = settings.interpolates() && has_mesh();
+  // An iterative solver that solver = auto chose needs the warm start as much as one named.
+  const bool iterative = linear.solver && linear.solver->kind() != SolverKind::kCholesky;
+  const bool interpolated = (settings.interpolates() || iterative) && has_mesh();
   const auto t0 = std::chrono::steady_clock::now();
   if (interpolated) {
     const std::vector<int> located = mesh_->tri.locate_all(mesh.cells.power_centre);

@@ -1,0 +1,61 @@
+"""The steady step of the C++ engine alone (pfv.Engine, no YADE) on bench/growth.py's jittered lattice.
+
+    /usr/bin/python3 bench/core_steady.py [N ...]        (default 250000 500000 1000000; PYTHONPATH=build/python)
+
+Multigrid, permeameter along y (p = 100 on ymin, 0 on ymax, viscosity 1e-3), the walls at the spheres' extent, static
+spheres: a first step, then five steady steps, each with its stages from step_times() (dV/dt, solve, forces, total).
+Set beside bench/growth.py's flow step of pfv.FlowEngine in YADE on the same lattice, the difference is what the step
+costs outside the core (reading positions, writing forces, the time-step guard). No timing is asserted anywhere.
+"""
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from lattice import jittered_lattice  # noqa: E402
+
+import pfv  # noqa: E402
+
+KEYS = ('volumes', 'solve', 'forces', 'total')
+
+
+def measure(n, steady=5):
+    pos, rad = jittered_lattice(n)
+    lo, hi = (pos - rad[:, None]).min(0), (pos + rad[:, None]).max(0)
+    walls = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
+    e = pfv.Engine()
+    e.bnd_is_pressure = [False, False, True, True, False, False]
+    e.bnd_value = [0, 0, 100.0, 0, 0, 0]
+    e.viscosity = 1e-3
+    e.mesh_update_interval = 10 ** 9
+    e.solver = 'multigrid'
+    t0 = time.perf_counter()
+    e.step(pos, rad, walls, 1e-4)
+    first = time.perf_counter() - t0
+    walls_s, stages = [], []
+    for _ in range(steady):
+        t0 = time.perf_counter()
+        e.step(pos, rad, walls, 1e-4)
+        walls_s.append(time.perf_counter() - t0)
+        stages.append(dict(e.step_times()))
+    med = {k: float(np.median([s[k] for s in stages])) for k in KEYS}
+    return dict(n=n, cells=e.n_cells(), first=first, steady=walls_s, median=med)
+
+
+def main(argv):
+    sizes = [int(float(a)) for a in argv] or [250000, 500000, 1000000]
+    print('| N | cells | first step [s] | steady step [s] | dV/dt [ms] | solve [ms] | forces [ms] | per sphere [µs] |')
+    print('|---|---|---|---|---|---|---|---|')
+    for n in sizes:
+        r = measure(n)
+        m = r['median']
+        print(f"| {n:,} | {r['cells']:,} | {r['first']:.1f} | {m['total']:.3f} | {1e3 * m['volumes']:.0f} | "
+              f"{1e3 * m['solve']:.0f} | {1e3 * m['forces']:.0f} | {1e6 * m['total'] / n:.2f} |".replace(',', '\u202f'),
+              flush=True)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))

@@ -87,10 +87,11 @@ struct EngineSettings {
   SolveControl solve_control() const {
     return {tolerance, relax, max_iterations, refinement_tolerance, max_refinement_passes};
   }
-  // Whether a remesh carries the old mesh's cell states over (see interpolate_on_remesh).
-  bool interpolates() const {
-    return solver == SolverKind::kGaussSeidel || solver == SolverKind::kConjugateGradient ||
-           solver == SolverKind::kMultigrid || fluid_bulk_modulus > 0 || interpolate_on_remesh;
+  // Whether a remesh carries the old mesh's cell states over (see interpolate_on_remesh), for
+  // the solver in use: under kAuto the one chosen, which may be iterative.
+  bool interpolates(SolverKind in_use) const {
+    return in_use == SolverKind::kGaussSeidel || in_use == SolverKind::kConjugateGradient ||
+           in_use == SolverKind::kMultigrid || fluid_bulk_modulus > 0 || interpolate_on_remesh;
   }
   // The ordering CHOLMOD is asked for.
   Ordering factor_ordering() const { return force_metis ? Ordering::kMetis : ordering; }

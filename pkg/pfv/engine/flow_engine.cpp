@@ -252,7 +252,9 @@ CellConditions FlowEngine::flat_cells(const PoreMesh& m, const EngineSettings& s
 
 bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditions, const std::vector<Vec3>& centres,
                                      const BoxWalls& walls) const {
-  if (!has_mesh() || cells_.blocked.empty() || !settings.interpolates()) return false;
+  // The current solver: the one a remesh keeps under solver = auto.
+  const SolverKind in_use = linear_.solver ? linear_.solver->kind() : settings.solver;
+  if (!has_mesh() || cells_.blocked.empty() || !settings.interpolates(in_use)) return false;
   if (centres.size() != static_cast<std::size_t>(m.mesh().n_spheres)) return false;
   bool carried = false;
   const int n = m.mesh().n_cells();
@@ -281,9 +283,8 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& 
   // start of the iterative solvers. (The direct solve of an incompressible fluid needs neither,
   // unless asked for: interpolate_on_remesh.)
   std::vector<double> pressure(mesh.mesh().n_cells(), settings.p_zero);
-  // An iterative solver that solver = auto chose needs the warm start as much as one named.
-  const bool iterative = linear.solver && linear.solver->kind() != SolverKind::kCholesky;
-  const bool interpolated = (settings.interpolates() || iterative) && has_mesh();
+  const bool interpolated =
+      settings.interpolates(linear.solver ? linear.solver->kind() : settings.solver) && has_mesh();
   const auto t0 = std::chrono::steady_clock::now();
   if (interpolated) {
     const std::vector<int> located = mesh_->tri.locate_all(mesh.cells.power_centre);

@@ -220,7 +220,7 @@ class FlowEngine {
   void adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system = true);
   // The conditions of a new mesh: its cells of at most settings.flat_threshold volume blocked.
   static CellConditions flat_cells(const PoreMesh& mesh, const EngineSettings& settings);
-  // With settings.interpolates(), blocks the cells of the new mesh whose barycentres (at these
+  // With settings.interpolates(solver in use), blocks the cells of the new mesh whose barycentres (at these
   // positions) lie in a blocked cell of the current one; returns whether it blocked any.
   bool carry_blocked_cells(const PoreMesh& mesh, CellConditions& conditions, const std::vector<Vec3>& centres,
                            const BoxWalls& walls) const;

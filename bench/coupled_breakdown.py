@@ -2,7 +2,8 @@
 
     yade-double -j1 -n -x bench/coupled_breakdown.py [--n=1000000]
 
-The scene of bench/growth.py (N fixed spheres on the jittered lattice, aabbWalls, permeameter along y, multigrid):
+The scene and the engine of bench/growth.py (build_scene, make_flow: N fixed spheres on the jittered lattice,
+aabbWalls, permeameter along y, multigrid):
 a dry step before the flow engine is added, the first coupled step (wall time, the core's share, and cProfile's view
 of the Python side), then a steady coupled step with every engine's execTime (O.timingEnabled) and the core's
 step_times()['total'], and cProfile of one more steady step. The DEM engines' execTime beside the flow engine against
@@ -17,7 +18,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
-from lattice import jittered_lattice  # noqa: E402
+import growth  # noqa: E402  (its scene and engine settings)
 
 
 def option(name, default):
@@ -43,34 +44,17 @@ def profile_step(label, rows=12):
 
 
 def main():
-    from yade import O, utils
-    from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, Ig2_Box_Sphere_ScGeom,
-                              Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                              Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator)
-    from pfv import FlowEngine
+    from yade import O
     n = option('n', 1000000)
-    centres, radii = jittered_lattice(n, 1)
-    lo, hi = (centres - radii[:, None]).min(axis=0), (centres + radii[:, None]).max(axis=0)
-    O.bodies.append(utils.aabbWalls([tuple(lo), tuple(hi)], thickness=0))
-    O.bodies.append([utils.sphere(tuple(c), float(r), fixed=True) for c, r in zip(centres, radii)])
-    O.dt = 1e-5
-    O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-                 InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
-                                 [Ip2_FrictMat_FrictMat_FrictPhys()], [Law2_ScGeom_FrictPhys_CundallStrack()]),
-                 NewtonIntegrator(damping=0.2)]
-    for _ in range(2):  # the collider's first runs
-        O.step()
+    growth.build_scene(n)
     dry = []
     for _ in range(3):
         t0 = time.perf_counter()
         O.step()
         dry.append(time.perf_counter() - t0)
     print('N = %d: dry steps %s s' % (n, ', '.join('%.3f' % d for d in dry)))
-    flow = FlowEngine(wallIds=[0, 1, 2, 3, 4, 5], bndCondIsPressure=[0, 0, 1, 1, 0, 0],
-                      bndCondValue=[0, 0, 100.0, 0, 0, 0], boundaryUseMaxMin=[0] * 6, viscosity=1e-3,
-                      slipBoundary=False, meshUpdateInterval=10 ** 9, defTolerance=0.0)
-    flow.solver = 'multigrid'
-    O.engines = O.engines[:-1] + [flow] + O.engines[-1:]
+    flow = growth.make_flow('pfv-multigrid')
+    growth.insert(flow)
     profile_step('first coupled step')
     print('   of which the core step %.2f s' % flow.core.step_times()['total'])
     for _ in range(2):

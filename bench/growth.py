@@ -373,4 +373,5 @@ def main():
     sys.exit(0)
 
 
-main()
+if __name__ == "__main__":  # yade -x runs the script as __main__; importing it runs nothing
+    main()

@@ -79,12 +79,15 @@ def run(load_name, load, sample, duration, out, period, settings=None):
     builtins.seabed_monitor = monitor
     record = max(1, int(round(duration / 400 / O.dt)))
     O.engines = O.engines + [PyRunner(command="seabed_monitor()", iterPeriod=record)]
+    # Long runs keep the record on disk as they go, so a run stopped early still leaves its time series.
+    os.makedirs(out, exist_ok=True)
+    builtins.seabed_checkpoint = lambda: plot.saveDataTxt(os.path.join(out, "timeseries.csv"))
+    O.engines = O.engines + [PyRunner(command="seabed_checkpoint()", iterPeriod=25 * record)]
     start = np.array([tuple(b.state.pos) for b in O.bodies if b.shape.__class__.__name__ == "Sphere"])
     plot.reset()
     wall = time.time()
     O.run(int(math.ceil(duration / O.dt)), True)
     wall = time.time() - wall
-    os.makedirs(out, exist_ok=True)
     plot.saveDataTxt(os.path.join(out, "timeseries.csv"))
     diagnostics.save_plots(plot.data, os.path.join(out, "waves.png"), LIQUEFIED)
 

@@ -11,6 +11,7 @@
 #include "pfv/linalg/amg_solver.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/linalg/gauss_seidel_solver.hpp"
+#include "pfv/linalg/geometric_ordering.hpp"
 #include "pfv/linalg/pcg_solver.hpp"
 #include "pfv/model/cell_queries.hpp"
 #include "pfv/snapshot/snapshot.hpp"
@@ -48,6 +49,7 @@ bool ordering_fits(const CellOrdering& previous, Ordering wanted) {
     case Ordering::kNestedDissection:
       return previous.from_metis();
     case Ordering::kAmd:
+    case Ordering::kGeometric:
       return !previous.from_metis();
     case Ordering::kAuto:
     case Ordering::kCholmod:
@@ -195,6 +197,8 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   l.times.assembly = seconds_since(t0);
 
   t0 = StageClock::now();
+  bool fresh_order = false;  // a geometric order computed here, not carried over
+  double ordering_seconds = 0;
   if (s.n_unknowns() > 0) {
     if (CholeskySolver* cholesky = l.cholesky()) {
       FactorOptions options;
@@ -206,6 +210,18 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
         options.given.perm = previous->carry_over(m.mesh(), s);
         options.given.max_fill = settings.max_fill_growth * previous->fresh_fill();
         options.given.from_metis = previous->from_metis();
+      }
+      if (options.ordering == Ordering::kGeometric && options.given.perm.empty()) {
+        const auto t_order = StageClock::now();
+        std::vector<std::array<double, 3>> point(s.n_unknowns());
+        for (int u = 0; u < s.n_unknowns(); ++u) {
+          const Vec3& c = m.cells.power_centre[s.unknown_cell[u]];
+          point[u] = {c[0], c[1], c[2]};
+        }
+        options.given.perm = geometric_ordering(s, point);
+        options.given.max_fill = std::numeric_limits<double>::infinity();
+        options.given.fresh = fresh_order = true;
+        ordering_seconds = seconds_since(t_order);
       }
       if (automatic) options.max_entries = budget;
       try {
@@ -225,10 +241,10 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       // The refinement's residual reads G by rows; a double factor never does.
       if (f.reduced_precision()) index_rows(l.system);
       if (f.ready() && f.permutation())
-        l.ordering = std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
-                                                          f.ordering_given() ? previous->fresh_fill() : f.fill(),
-                                                          f.metis_used());
-      l.times.analysis = f.analysis_seconds();
+        l.ordering = std::make_shared<const CellOrdering>(
+            m.mesh(), s, f.permutation(), f.chains(),
+            f.ordering_given() && !fresh_order ? previous->fresh_fill() : f.fill(), f.metis_used());
+      l.times.analysis = ordering_seconds + f.analysis_seconds();
     } else if (auto* pcg = dynamic_cast<PcgSolver*>(l.solver.get())) {
       pcg->setup(s);
     } else if (auto* amg = dynamic_cast<AmgSolver*>(l.solver.get())) {

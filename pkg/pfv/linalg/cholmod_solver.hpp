@@ -23,7 +23,8 @@ struct SupernodalChains {
 
 // Fill-reducing ordering. kCholmod: CHOLMOD's default rule (AMD, then METIS if AMD fills badly,
 // the better kept); kAuto: that rule below kMetisDirectFrom unknowns, METIS alone from there on.
-enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection, kCholmod };
+// kGeometric: nested dissection by coordinate planes (geometric_ordering.hpp).
+enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection, kCholmod, kGeometric };
 
 // From this many unknowns kAuto orders by METIS alone. On sub-cubes of the benchmark packing
 // (bench/solver_stages.py section 7) METIS's factor has at most 0.7 x AMD's entries from 8 000
@@ -53,6 +54,7 @@ struct GivenOrdering {
   std::vector<int> perm;  // perm[k] = unknown eliminated k-th; empty: none
   double max_fill = 0;
   bool from_metis = false;  // where the order it descends from came from (for metis_used)
+  bool fresh = false;       // computed for this system (not carried over): its fill is a fresh fill
 };
 
 // Thrown by CholmodSolver::factorize when the analysed factor would store more values than

@@ -200,18 +200,17 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&EngineSettings::max_iterations))
       .def_property("force_metis", get_setting(&EngineSettings::force_metis), set_setting(&EngineSettings::force_metis))
       .def_property("ordering", exclusive([](const SharedEngine& e) {
-                      const char* names[] = {"auto", "amd", "metis", "nesdis", "cholmod"};
+                      const char* names[] = {"auto", "amd", "metis", "nesdis", "cholmod", "geometric"};
                       return std::string(names[static_cast<int>(e.settings.ordering)]);
                     }),
                     exclusive([](SharedEngine& e, const std::string& v) {
-                      const std::map<std::string, Ordering> names{{"auto", Ordering::kAuto},
-                                                                  {"amd", Ordering::kAmd},
-                                                                  {"metis", Ordering::kMetis},
-                                                                  {"nesdis", Ordering::kNestedDissection},
-                                                                  {"cholmod", Ordering::kCholmod}};
+                      const std::map<std::string, Ordering> names{
+                          {"auto", Ordering::kAuto},       {"amd", Ordering::kAmd},
+                          {"metis", Ordering::kMetis},     {"nesdis", Ordering::kNestedDissection},
+                          {"cholmod", Ordering::kCholmod}, {"geometric", Ordering::kGeometric}};
                       const auto it = names.find(v);
                       if (it == names.end())
-                        throw py::value_error("ordering must be one of auto, amd, metis, nesdis, cholmod");
+                        throw py::value_error("ordering must be one of auto, amd, metis, nesdis, cholmod, geometric");
                       update(e, [&](EngineSettings& s) { s.ordering = it->second; });
                     }))
       .def_property("mixed_precision", get_setting(&EngineSettings::mixed_precision),

@@ -1,0 +1,293 @@
+#include "pfv/linalg/geometric_ordering.hpp"
+
+#include <suitesparse/camd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include "pfv/model/pressure_system.hpp"
+
+namespace pfv {
+
+namespace {
+
+// G's pattern without the diagonal, both triangles, by rows.
+struct Graph {
+  std::vector<int> start, next;
+};
+
+Graph symmetric_pattern(const PressureSystem& s) {
+  const int n = s.n_unknowns();
+  Graph g;
+  g.start.assign(n + 1, 0);
+  for (int j = 0; j < n; ++j)
+    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e)
+      if (s.row[e] != j) {
+        ++g.start[s.row[e] + 1];
+        ++g.start[j + 1];
+      }
+  std::partial_sum(g.start.begin(), g.start.end(), g.start.begin());
+  g.next.resize(g.start[n]);
+  std::vector<int> fill(g.start.begin(), g.start.end() - 1);
+  for (int j = 0; j < n; ++j)
+    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e)
+      if (const int i = s.row[e]; i != j) {
+        g.next[fill[i]++] = j;
+        g.next[fill[j]++] = i;
+      }
+  return g;
+}
+
+// Dinic's maximum flow, for the small band graphs of the separators; the storage is kept from
+// one graph to the next. The search for augmenting paths is iterative: a path may be long.
+class MaxFlow {
+ public:
+  static constexpr int kInfinite = 1 << 30;
+
+  void reset(int nodes) {
+    head_.assign(nodes, -1);
+    to_.clear();
+    cap_.clear();
+    next_.clear();
+  }
+
+  void add(int a, int b, int cap) {
+    link(a, b, cap);
+    link(b, a, 0);
+  }
+
+  void run(int source, int sink) {
+    while (levels(source, sink)) {
+      edge_ = head_;
+      while (augment(source, sink)) {
+      }
+    }
+  }
+
+  // Whether the source reaches 'node' in the residual graph, after run(): the source's side of
+  // a minimum cut.
+  bool reached(int node) const { return level_[node] >= 0; }
+
+ private:
+  void link(int a, int b, int cap) {
+    to_.push_back(b);
+    cap_.push_back(cap);
+    next_.push_back(head_[a]);
+    head_[a] = static_cast<int>(to_.size()) - 1;
+  }
+
+  // Breadth-first levels from the source; nodes no nearer than the sink are not expanded.
+  bool levels(int source, int sink) {
+    level_.assign(head_.size(), -1);
+    level_[source] = 0;
+    queue_.assign(1, source);
+    for (std::size_t q = 0; q < queue_.size(); ++q) {
+      const int a = queue_[q];
+      if (level_[sink] >= 0 && level_[a] >= level_[sink]) break;
+      for (int e = head_[a]; e >= 0; e = next_[e])
+        if (cap_[e] > 0 && level_[to_[e]] < 0) {
+          level_[to_[e]] = level_[a] + 1;
+          queue_.push_back(to_[e]);
+        }
+    }
+    return level_[sink] >= 0;
+  }
+
+  // One augmenting path along increasing levels (edge_[a]: the next edge of a to try).
+  bool augment(int source, int sink) {
+    path_.clear();
+    int a = source;
+    while (a != sink) {
+      int& e = edge_[a];
+      while (e >= 0 && (cap_[e] <= 0 || level_[to_[e]] != level_[a] + 1)) e = next_[e];
+      if (e >= 0) {
+        path_.push_back(e);
+        a = to_[e];
+      } else {
+        if (a == source) return false;
+        level_[a] = -2;  // a dead end for the rest of this phase
+        path_.pop_back();
+        a = path_.empty() ? source : to_[path_.back()];
+        edge_[a] = next_[edge_[a]];
+      }
+    }
+    int f = kInfinite;
+    for (int e : path_) f = std::min(f, cap_[e]);
+    for (int e : path_) {
+      cap_[e] -= f;
+      cap_[e ^ 1] += f;
+    }
+    return true;
+  }
+
+  std::vector<int> head_, to_, cap_, next_, level_, edge_, queue_, path_;
+};
+
+class Dissection {
+ public:
+  Dissection(const Graph& g, const std::vector<std::array<double, 3>>& point, const GeometricOrderingOptions& o)
+      : g_(g), point_(point), leaf_size_(std::max(o.leaf_size, 2)), band_layers_(o.band_layers) {
+    const int n = static_cast<int>(point.size());
+    order_.resize(n);
+    std::iota(order_.begin(), order_.end(), 0);
+    part_.assign(n, 0);
+    side_.assign(n, 0);
+    slot_.assign(n, -1);
+    level.assign(n, -1);
+  }
+
+  // Splits the unknowns down to the leaves; level[u] is then the depth of the separator
+  // holding u, -1 for a leaf's unknown.
+  void run() {
+    struct Part {
+      int begin, end, depth;
+    };
+    std::vector<Part> todo{{0, static_cast<int>(order_.size()), 0}};
+    while (!todo.empty()) {
+      const Part p = todo.back();
+      todo.pop_back();
+      if (p.end - p.begin <= leaf_size_) continue;
+      const int id = part_[order_[p.begin]];
+      separate(p.begin, p.end, best_axis(p.begin, p.end, id), id);
+      max_depth = std::max(max_depth, p.depth);
+      // Lower side, upper side, then the separator (the unknowns taken out of the part).
+      const auto sep =
+          std::stable_partition(order_.begin() + p.begin, order_.begin() + p.end, [&](int u) { return part_[u] >= 0; });
+      for (auto k = sep; k != order_.begin() + p.end; ++k) level[*k] = p.depth;
+      const auto upper = std::stable_partition(order_.begin() + p.begin, sep, [&](int u) { return side_[u] == 0; });
+      const int r = static_cast<int>(upper - order_.begin()), s = static_cast<int>(sep - order_.begin());
+      const int lower_id = ++parts_, upper_id = ++parts_;
+      for (int k = p.begin; k < r; ++k) part_[order_[k]] = lower_id;
+      for (int k = r; k < s; ++k) part_[order_[k]] = upper_id;
+      todo.push_back({p.begin, r, p.depth + 1});
+      todo.push_back({r, s, p.depth + 1});
+    }
+  }
+
+  std::vector<int> level;
+  int max_depth = -1;
+
+ private:
+  void select(int begin, int nth, int end, int axis) {
+    std::nth_element(order_.begin() + begin, order_.begin() + nth, order_.begin() + end,
+                     [&](int a, int b) { return point_[a][axis] < point_[b][axis]; });
+  }
+
+  // The axis whose median plane cuts the fewest edges of the part (the smallest cross-section).
+  int best_axis(int begin, int end, int id) {
+    const int mid = begin + (end - begin) / 2;
+    int best = 0;
+    long best_cut = -1;
+    for (int axis = 0; axis < 3; ++axis) {
+      select(begin, mid, end, axis);
+      for (int k = begin; k < end; ++k) side_[order_[k]] = k < mid ? 0 : 1;
+      long cut = 0;
+      for (int k = begin; k < mid; ++k) {
+        const int u = order_[k];
+        for (int e = g_.start[u]; e < g_.start[u + 1]; ++e) cut += part_[g_.next[e]] == id && side_[g_.next[e]] == 1;
+      }
+      if (best_cut < 0 || cut < best_cut) {
+        best_cut = cut;
+        best = axis;
+      }
+    }
+    return best;
+  }
+
+  // The smallest vertex separator, among the unknowns of a band around the median plane along
+  // 'axis', between the unknowns below and above the band: a minimum cut of the band graph
+  // with each band unknown split in two joined by a unit capacity (Menger's theorem). Marks the
+  // separator part_ = -1 and every other unknown of the part with its side_ (0 below, 1 above).
+  void separate(int begin, int end, int axis, int id) {
+    const int m = end - begin, mid = begin + m / 2;
+    // At most half the part in the band: both sides keep a core, so both children are smaller.
+    const int half = std::clamp(static_cast<int>(band_layers_ * std::cbrt(static_cast<double>(m) * m)), 1, m / 4);
+    const int lo = mid - half, hi = mid + half;
+    select(begin, mid, end, axis);
+    select(begin, lo, mid, axis);
+    select(mid, hi, end, axis);
+    // side_ 0: below the band, 1: above, 2: in it; an edge from below to above pulls its lower end in.
+    for (int k = begin; k < end; ++k) side_[order_[k]] = k < lo ? 0 : k < hi ? 2 : 1;
+    band_.clear();
+    for (int k = begin; k < end; ++k) {
+      const int u = order_[k];
+      if (side_[u] == 0)
+        for (int e = g_.start[u]; e < g_.start[u + 1]; ++e)
+          if (part_[g_.next[e]] == id && side_[g_.next[e]] == 1) {
+            side_[u] = 2;
+            break;
+          }
+      if (side_[u] == 2) {
+        slot_[u] = static_cast<int>(band_.size());
+        band_.push_back(u);
+      }
+    }
+    // Nodes: 0 the source (below), 1 the sink (above), 2 + 2k and 3 + 2k the entry and exit of
+    // band unknown k.
+    const int nb = static_cast<int>(band_.size());
+    flow_.reset(2 + 2 * nb);
+    for (int k = 0; k < nb; ++k) {
+      const int u = band_[k];
+      flow_.add(2 + 2 * k, 3 + 2 * k, 1);
+      bool below = false, above = false;
+      for (int e = g_.start[u]; e < g_.start[u + 1]; ++e) {
+        const int v = g_.next[e];
+        if (part_[v] != id) continue;
+        if (side_[v] == 2)
+          flow_.add(3 + 2 * k, 2 + 2 * slot_[v], MaxFlow::kInfinite);
+        else
+          (side_[v] == 0 ? below : above) = true;
+      }
+      if (below) flow_.add(0, 2 + 2 * k, MaxFlow::kInfinite);
+      if (above) flow_.add(3 + 2 * k, 1, MaxFlow::kInfinite);
+    }
+    flow_.run(0, 1);
+    for (int k = 0; k < nb; ++k) {
+      const bool in = flow_.reached(2 + 2 * k), out = flow_.reached(3 + 2 * k);
+      if (in && !out)
+        part_[band_[k]] = -1;  // a saturated unit edge of the cut
+      else
+        side_[band_[k]] = out ? 0 : 1;
+    }
+  }
+
+  const Graph& g_;
+  const std::vector<std::array<double, 3>>& point_;
+  const int leaf_size_;
+  const double band_layers_;
+  MaxFlow flow_;
+  std::vector<int> order_, part_, slot_, band_;
+  std::vector<char> side_;
+  int parts_ = 0;
+};
+
+}  // namespace
+
+std::vector<int> geometric_ordering(const PressureSystem& s, const std::vector<std::array<double, 3>>& point,
+                                    const GeometricOrderingOptions& options) {
+  const int n = s.n_unknowns();
+  if (static_cast<int>(point.size()) != n)
+    throw std::invalid_argument("geometric ordering: " + std::to_string(point.size()) + " points for " +
+                                std::to_string(n) + " unknowns");
+  for (const auto& p : point)
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw std::invalid_argument("geometric ordering: a point is not finite");
+  std::vector<int> perm(n);
+  if (n == 0) return perm;
+  const Graph g = symmetric_pattern(s);
+  Dissection d(g, point, options);
+  d.run();
+  // CAMD eliminates constraint class 0 first: the leaves, then the separators from the deepest up.
+  std::vector<int> constraint(n);
+  for (int u = 0; u < n; ++u) constraint[u] = d.level[u] < 0 ? 0 : d.max_depth + 1 - d.level[u];
+  double control[CAMD_CONTROL], info[CAMD_INFO];
+  camd_defaults(control);
+  const int status = camd_order(n, s.col_start.data(), s.row.data(), perm.data(), control, info, constraint.data());
+  if (status < CAMD_OK) throw std::runtime_error("CAMD ordering failed (status " + std::to_string(status) + ")");
+  return perm;
+}
+
+}  // namespace pfv

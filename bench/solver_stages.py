@@ -18,9 +18,10 @@
    (getrusage: the factor's storage is reused from the second mesh on);
 6. the collective viscous limit of a first mesh (drained top, viscosity 10, density 2600): the engine's Arnoldi
    (at most 40 operator applications) against power iteration from the same fixed start, 40 and 120 iterations;
-7. the first ordering against the size (the threshold kMetisDirectFrom of ordering="auto"): sub-cubes of the packing
-   of about 1 000 to 32 000 spheres and the whole packing, each ordered by AMD alone, METIS alone and CHOLMOD's rule
-   (ordering="cholmod": AMD, then METIS if AMD fills badly, the better kept; what "auto" does below the threshold):
+7. the first ordering against the size (the threshold kGeometricFrom of ordering="auto"): sub-cubes of the packing
+   of about 1 000 to 32 000 spheres and the whole packing, each ordered by AMD alone, METIS alone, the geometric
+   nested dissection (ordering="geometric") and CHOLMOD's rule (ordering="cholmod": AMD, then METIS if AMD fills
+   badly, the better kept; what "auto" does below the threshold):
    analysis and factorisation times, nnz(L), the solve, and which ordering the rule keeps.
 Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers;
 section 2 imitates the DEM's eviction of the factor).
@@ -212,12 +213,13 @@ def collective_limit(pos, rad, walls):
 
 
 def ordering_threshold(pos, rad, L, repeats=3):
-    """Section 7: the first ordering of sub-cubes of the packing, AMD alone, METIS alone and CHOLMOD's rule."""
+    """Section 7: the first ordering of sub-cubes of the packing: AMD alone, METIS alone, the geometric nested
+    dissection and CHOLMOD's rule."""
     print('7. first ordering against the size (medians of %d fresh engines each; the solve: the double factor)'
           % repeats)
-    print('   %8s %8s | %-38s | %-38s | %-24s' % ('spheres', 'unknowns', 'AMD: analysis, factor, nnz(L), solve',
-                                                  'METIS: analysis, factor, nnz(L), solve',
-                                                  "CHOLMOD's rule: analysis, kept"))
+    print('   %8s %8s | %-38s | %-38s | %-38s | %-24s'
+          % ('spheres', 'unknowns', 'AMD: analysis, factor, nnz(L), solve', 'METIS: analysis, factor, nnz(L), solve',
+             'geometric: analysis, factor, nnz(L), solve', "CHOLMOD's rule: analysis, kept"))
     for target in (1000, 2000, 3000, 4000, 8000, 16000, 32000, 64000):
         if target > 1.2 * len(rad):
             break
@@ -225,7 +227,7 @@ def ordering_threshold(pos, rad, L, repeats=3):
         inside = np.all(pos - rad[:, None] >= 0, axis=1) & np.all(pos + rad[:, None] <= side, axis=1)
         p, r, walls = pos[inside].copy(), rad[inside].copy(), [0, side, 0, side, 0, side]
         row = {}
-        for name in ('amd', 'metis', 'cholmod'):
+        for name in ('amd', 'metis', 'geometric', 'cholmod'):
             runs = []
             for _ in range(repeats):
                 e = engine()
@@ -238,11 +240,11 @@ def ordering_threshold(pos, rad, L, repeats=3):
                 unknowns = e.n_unknowns()
             row[name] = [float(np.median([x[k] for x in runs])) for k in range(4)] + [{x[4] for x in runs}]
         kept = '/'.join(sorted('METIS' if m else 'AMD' for m in row['cholmod'][4]))
-        print('   %8d %8d | %7.3f s %7.3f s %8.3g %6.2f ms | %7.3f s %7.3f s %8.3g %6.2f ms | %7.3f s  %s'
-              % (len(r), unknowns, *row['amd'][:3], 1e3 * row['amd'][3], *row['metis'][:3], 1e3 * row['metis'][3],
-                 row['cholmod'][0], kept))
-    print('   ordering="auto" is CHOLMOD\'s rule below %d unknowns and METIS alone from there on'
-          % pfv.Engine.metis_direct_from)
+        cells = ' | '.join('%7.3f s %7.3f s %8.3g %6.2f ms' % (*row[k][:3], 1e3 * row[k][3])
+                           for k in ('amd', 'metis', 'geometric'))
+        print('   %8d %8d | %s | %7.3f s  %s' % (len(r), unknowns, cells, row['cholmod'][0], kept))
+    print('   ordering="auto" is CHOLMOD\'s rule below %d unknowns and the geometric nested dissection from there on'
+          % pfv.Engine.geometric_from)
 
 
 def main():

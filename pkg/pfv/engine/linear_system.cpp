@@ -197,8 +197,6 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   l.times.assembly = seconds_since(t0);
 
   t0 = StageClock::now();
-  bool fresh_order = false;  // a geometric order computed here, not carried over
-  double ordering_seconds = 0;
   if (s.n_unknowns() > 0) {
     if (CholeskySolver* cholesky = l.cholesky()) {
       FactorOptions options;
@@ -211,18 +209,15 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
         options.given.max_fill = settings.max_fill_growth * previous->fresh_fill();
         options.given.from_metis = previous->from_metis();
       }
-      if (options.ordering == Ordering::kGeometric && options.given.perm.empty()) {
-        const auto t_order = StageClock::now();
-        std::vector<std::array<double, 3>> point(s.n_unknowns());
-        for (int u = 0; u < s.n_unknowns(); ++u) {
-          const Vec3& c = m.cells.power_centre[s.unknown_cell[u]];
-          point[u] = {c[0], c[1], c[2]};
-        }
-        options.given.perm = geometric_ordering(s, point);
-        options.given.max_fill = std::numeric_limits<double>::infinity();
-        options.given.fresh = fresh_order = true;
-        ordering_seconds = seconds_since(t_order);
-      }
+      if (options.ordering == Ordering::kGeometric || options.ordering == Ordering::kAuto)
+        options.given.geometric = [&s, &m] {
+          std::vector<std::array<double, 3>> point(s.n_unknowns());
+          for (int u = 0; u < s.n_unknowns(); ++u) {
+            const Vec3& c = m.cells.power_centre[s.unknown_cell[u]];
+            point[u] = {c[0], c[1], c[2]};
+          }
+          return geometric_ordering(s, point);
+        };
       if (automatic) options.max_entries = budget;
       try {
         cholesky->setup(s, options);
@@ -241,10 +236,10 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       // The refinement's residual reads G by rows; a double factor never does.
       if (f.reduced_precision()) index_rows(l.system);
       if (f.ready() && f.permutation())
-        l.ordering = std::make_shared<const CellOrdering>(
-            m.mesh(), s, f.permutation(), f.chains(),
-            f.ordering_given() && !fresh_order ? previous->fresh_fill() : f.fill(), f.metis_used());
-      l.times.analysis = ordering_seconds + f.analysis_seconds();
+        l.ordering = std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
+                                                          f.ordering_given() ? previous->fresh_fill() : f.fill(),
+                                                          f.metis_used());
+      l.times.analysis = f.analysis_seconds();
     } else if (auto* pcg = dynamic_cast<PcgSolver*>(l.solver.get())) {
       pcg->setup(s);
     } else if (auto* amg = dynamic_cast<AmgSolver*>(l.solver.get())) {

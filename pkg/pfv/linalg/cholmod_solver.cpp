@@ -133,12 +133,16 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     if (f && !ordering_given_) cholmod_free_factor(&f, c);
     metis_used_ = given.from_metis;
   }
-  if (!ordering_given_) {
-    if (ordering == Ordering::kCholmod || (ordering == Ordering::kAuto && n < kMetisDirectFrom)) {
+  const bool geometric = ordering == Ordering::kGeometric || (ordering == Ordering::kAuto && n >= kGeometricFrom);
+  if (!ordering_given_ && geometric) {
+    if (!given.geometric) throw std::invalid_argument("the geometric ordering needs the unknowns' positions");
+    std::vector<int> perm = given.geometric();
+    c->nmethods = 1;
+    c->method[0].ordering = CHOLMOD_GIVEN;
+    f = cholmod_analyze_p(&a, perm.data(), nullptr, 0, c);
+  } else if (!ordering_given_) {
+    if (ordering == Ordering::kCholmod || ordering == Ordering::kAuto) {
       c->nmethods = 0;
-    } else if (ordering == Ordering::kAuto) {
-      c->nmethods = 1;
-      c->method[0].ordering = CHOLMOD_METIS;
     } else {
       c->nmethods = 1;
       c->method[0].ordering = ordering == Ordering::kAmd     ? CHOLMOD_AMD

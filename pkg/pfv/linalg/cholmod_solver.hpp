@@ -2,6 +2,7 @@
 // forward/back substitution each step, into buffers allocated at factorisation.
 // Owns every CHOLMOD object it creates (YADE leaked factors here).
 #pragma once
+#include <functional>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -22,17 +23,20 @@ struct SupernodalChains {
 };
 
 // Fill-reducing ordering. kCholmod: CHOLMOD's default rule (AMD, then METIS if AMD fills badly,
-// the better kept); kAuto: that rule below kMetisDirectFrom unknowns, METIS alone from there on.
-// kGeometric: nested dissection by coordinate planes (geometric_ordering.hpp).
+// the better kept); kGeometric: nested dissection by planes through the unknowns' positions
+// (geometric_ordering.hpp); kAuto: CHOLMOD's rule below kGeometricFrom unknowns, kGeometric from
+// there on.
 enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection, kCholmod, kGeometric };
 
-// From this many unknowns kAuto orders by METIS alone. On sub-cubes of the benchmark packing
-// (bench/solver_stages.py section 7) METIS's factor has at most 0.7 x AMD's entries from 8 000
-// unknowns on and its solve is 1.3 x faster or more, so its extra analysis is repaid within a few
-// hundred steps, and later remeshes carry the order over; CHOLMOD's own rule keeps AMD up to
-// about 20 000 unknowns and from there orders twice to keep METIS. Below this size the two
-// factors solve alike and CHOLMOD's rule, with AMD's cheaper analysis, is kept.
-inline constexpr int kMetisDirectFrom = 8000;
+// From this many unknowns kAuto orders by kGeometric. On sub-cubes of the benchmark packing
+// (bench/solver_stages.py section 7) a nested dissection's factor has at most 0.7 x AMD's
+// entries from 8 000 unknowns on and its solve is 1.3 x faster or more, so its extra analysis
+// is repaid within a few hundred steps, and later remeshes carry the order over; CHOLMOD's own
+// rule keeps AMD up to about 20 000 unknowns and from there orders twice to keep METIS. The
+// geometric dissection fills as little as METIS (0.96-1.01 x its entries) in 0.6-0.7 x its
+// time. Below this size AMD's factor solves as fast and CHOLMOD's rule, with AMD's cheaper
+// analysis, is kept.
+inline constexpr int kGeometricFrom = 8000;
 
 // kScaled32 keeps the factor, computed in double, as 32-bit integers with one double scale per
 // column (in CHOLMOD's array): L(i, j) ~ q(i, j) * max_i |L(i, j)| / (2^31 - 1). Half the memory
@@ -54,7 +58,8 @@ struct GivenOrdering {
   std::vector<int> perm;  // perm[k] = unknown eliminated k-th; empty: none
   double max_fill = 0;
   bool from_metis = false;  // where the order it descends from came from (for metis_used)
-  bool fresh = false;       // computed for this system (not carried over): its fill is a fresh fill
+  // Ordering::kGeometric: computes the fresh order when none is given or the given one fills too much.
+  std::function<std::vector<int>()> geometric;
 };
 
 // Thrown by CholmodSolver::factorize when the analysed factor would store more values than

@@ -159,6 +159,8 @@ class Dissection {
       for (auto k = sep; k != order_.begin() + p.end; ++k) level[*k] = p.depth;
       const auto upper = std::stable_partition(order_.begin() + p.begin, sep, [&](int u) { return side_[u] == 0; });
       const int r = static_cast<int>(upper - order_.begin()), s = static_cast<int>(sep - order_.begin());
+      // Nothing separated (a small part whose lower core the band took in): a leaf.
+      if (r - p.begin == p.end - p.begin || s - r == p.end - p.begin) continue;
       const int lower_id = ++parts_, upper_id = ++parts_;
       for (int k = p.begin; k < r; ++k) part_[order_[k]] = lower_id;
       for (int k = r; k < s; ++k) part_[order_[k]] = upper_id;
@@ -203,8 +205,9 @@ class Dissection {
   // separator part_ = -1 and every other unknown of the part with its side_ (0 below, 1 above).
   void separate(int begin, int end, int axis, int id) {
     const int m = end - begin, mid = begin + m / 2;
-    // At most half the part in the band: both sides keep a core, so both children are smaller.
-    const int half = std::clamp(static_cast<int>(band_layers_ * std::cbrt(static_cast<double>(m) * m)), 1, m / 4);
+    // At most half the part in the band, so that both sides keep a core (m >= 4).
+    const int half =
+        std::max(1, std::min(static_cast<int>(band_layers_ * std::cbrt(static_cast<double>(m) * m)), m / 4));
     const int lo = mid - half, hi = mid + half;
     select(begin, mid, end, axis);
     select(begin, lo, mid, axis);

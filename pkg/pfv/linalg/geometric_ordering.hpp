@@ -19,7 +19,7 @@ namespace pfv {
 struct PressureSystem;
 
 struct GeometricOrderingOptions {
-  int leaf_size = 64;  // parts of at most this many unknowns are not split further
+  int leaf_size = 64;  // parts of at most this many unknowns (at least 2) are not split further
   // Half the band searched for the separator, in layers of m^(2/3) unknowns of a part of m.
   double band_layers = 2;
 };

@@ -229,8 +229,9 @@ PYBIND11_MODULE(_core, m) {
       .def("n_unknowns", exclusive([](const SharedEngine& e) { return e.has_mesh() ? e.system().n_unknowns() : 0; }),
            "Unknown pressures of the current system (cells not imposed); 0 before the first step.")
       .def_property_readonly_static(
-          "metis_direct_from", [](const py::object&) { return kMetisDirectFrom; },
-          "Unknowns from which ordering='auto' orders by METIS alone (below: CHOLMOD's rule, AMD then METIS).")
+          "geometric_from", [](const py::object&) { return kGeometricFrom; },
+          "Unknowns from which ordering='auto' orders by the geometric nested dissection (below: CHOLMOD's rule, "
+          "AMD then METIS).")
       .def("reduced_precision_factor",
            exclusive([](const SharedEngine& e) { return e.cholesky() && e.cholmod().reduced_precision(); }))
       .def("refinement_contraction", exclusive(&FlowEngine::refinement_contraction))

@@ -30,8 +30,8 @@ enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection, kCholmod, kGeometr
 
 // From this many unknowns kAuto orders by kGeometric. On sub-cubes of the benchmark packing
 // (bench/solver_stages.py section 7) a nested dissection's factor has at most 0.7 x AMD's
-// entries from 8 000 unknowns on and its solve is 1.3 x faster or more, so its extra analysis
-// is repaid within a few hundred steps, and later remeshes carry the order over; CHOLMOD's own
+// entries from 8 000 unknowns on and its solve is 1.15 x faster or more (2.4 x at 166 000), so
+// its extra analysis is repaid within a few hundred steps, and later remeshes carry the order over; CHOLMOD's own
 // rule keeps AMD up to about 20 000 unknowns and from there orders twice to keep METIS. The
 // geometric dissection fills as little as METIS (0.96-1.01 x its entries) in 0.6-0.7 x its
 // time. Below this size AMD's factor solves as fast and CHOLMOD's rule, with AMD's cheaper

@@ -23,6 +23,7 @@ expect_error("YADE method out of scope", NotImplementedError, "getCavityFlux", l
 expect_error("non-positive viscosity", ValueError, "viscosity", lambda: setattr(flow, "viscosity", -1.0))
 expect_error("NaN viscosity", ValueError, "viscosity", lambda: setattr(flow, "viscosity", float("nan")))
 expect_error("query before any step", RuntimeError, "not run yet", lambda: flow.getBoundaryFlux(2))
+expect_error("unknown ordering", ValueError, "geometric", lambda: setattr(flow.core, "ordering", "geometrical"))
 
 # A good step, to compare against after each recovered failure.
 O.run(1, True)

@@ -111,3 +111,15 @@ TEST(GeometricOrdering, CarriedOverAtRemeshAndComputedAfreshWhenItFillsTooMuch) 
   EXPECT_FALSE(e.cholmod().metis_used());
   EXPECT_EQ(e.cholmod().fill(), solved(moved, Ordering::kGeometric).cholmod().fill());
 }
+
+TEST(GeometricOrdering, AskedForAfterAnotherOrderingIsComputedNotCarried) {
+  const auto p = test::random_packing(800, 36, 0.02, 0.03);
+  FlowEngine e = solved(p, Ordering::kAmd);
+  ASSERT_EQ(e.cholmod().origin(), OrderingOrigin::kMinimumDegree);
+  e.settings.ordering = Ordering::kGeometric;
+  e.request_remesh();
+  e.step(p.centre, p.radius, p.walls, 1.0);
+  EXPECT_FALSE(e.cholmod().ordering_given());
+  EXPECT_EQ(e.cholmod().origin(), OrderingOrigin::kGeometric);
+  EXPECT_EQ(e.cholmod().fill(), solved(p, Ordering::kGeometric).cholmod().fill());
+}

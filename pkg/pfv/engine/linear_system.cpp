@@ -41,16 +41,18 @@ std::vector<int> locate_points(const PoreMesh& m, const std::vector<PointConditi
   return cells;
 }
 
-// Whether a carried-over ordering is of the kind asked for: METIS (or its nested dissection)
-// or AMD when one is named (forceMetis must give a METIS ordering), anything under kAuto.
+// Whether a carried-over ordering is of the kind asked for: METIS (or its nested dissection),
+// AMD or the geometric dissection when one is named (forceMetis must give a METIS ordering),
+// anything under kAuto and kCholmod.
 bool ordering_fits(const CellOrdering& previous, Ordering wanted) {
   switch (wanted) {
     case Ordering::kMetis:
     case Ordering::kNestedDissection:
-      return previous.from_metis();
+      return previous.origin() == OrderingOrigin::kMetis;
     case Ordering::kAmd:
+      return previous.origin() == OrderingOrigin::kMinimumDegree;
     case Ordering::kGeometric:
-      return !previous.from_metis();
+      return previous.origin() == OrderingOrigin::kGeometric;
     case Ordering::kAuto:
     case Ordering::kCholmod:
       break;
@@ -207,7 +209,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       if (previous && settings.reuse_ordering && ordering_fits(*previous, options.ordering)) {
         options.given.perm = previous->carry_over(m.mesh(), s);
         options.given.max_fill = settings.max_fill_growth * previous->fresh_fill();
-        options.given.from_metis = previous->from_metis();
+        options.given.origin = previous->origin();
       }
       if (options.ordering == Ordering::kGeometric || options.ordering == Ordering::kAuto)
         options.given.geometric = [&s, &m] {
@@ -236,9 +238,9 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       // The refinement's residual reads G by rows; a double factor never does.
       if (f.reduced_precision()) index_rows(l.system);
       if (f.ready() && f.permutation())
-        l.ordering = std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
-                                                          f.ordering_given() ? previous->fresh_fill() : f.fill(),
-                                                          f.metis_used());
+        l.ordering =
+            std::make_shared<const CellOrdering>(m.mesh(), s, f.permutation(), f.chains(),
+                                                 f.ordering_given() ? previous->fresh_fill() : f.fill(), f.origin());
       l.times.analysis = f.analysis_seconds();
     } else if (auto* pcg = dynamic_cast<PcgSolver*>(l.solver.get())) {
       pcg->setup(s);

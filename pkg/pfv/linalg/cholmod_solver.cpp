@@ -131,7 +131,7 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     f = cholmod_analyze_p(&a, const_cast<int*>(given.perm.data()), nullptr, 0, c);
     ordering_given_ = f && c->lnz <= given.max_fill * n;
     if (f && !ordering_given_) cholmod_free_factor(&f, c);
-    metis_used_ = given.from_metis;
+    origin_ = given.origin;
   }
   const bool geometric = ordering == Ordering::kGeometric || (ordering == Ordering::kAuto && n >= kGeometricFrom);
   if (!ordering_given_ && geometric) {
@@ -140,6 +140,7 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     c->nmethods = 1;
     c->method[0].ordering = CHOLMOD_GIVEN;
     f = cholmod_analyze_p(&a, perm.data(), nullptr, 0, c);
+    origin_ = OrderingOrigin::kGeometric;
   } else if (!ordering_given_) {
     if (ordering == Ordering::kCholmod || ordering == Ordering::kAuto) {
       c->nmethods = 0;
@@ -150,6 +151,11 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
                                                              : CHOLMOD_NESDIS;
     }
     f = cholmod_analyze(&a, c);
+    if (f) {
+      const int selected = c->method[c->selected].ordering;
+      origin_ = selected == CHOLMOD_METIS || selected == CHOLMOD_NESDIS ? OrderingOrigin::kMetis
+                                                                        : OrderingOrigin::kMinimumDegree;
+    }
   }
   analysis_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!f) throw std::runtime_error("CHOLMOD analysis failed (status " + std::to_string(c->status) + ")");
@@ -159,8 +165,6 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     throw FactorTooLarge(stored, max_entries_);
   }
   factor_ = f;
-  if (!ordering_given_)
-    metis_used_ = c->method[c->selected].ordering == CHOLMOD_METIS || c->method[c->selected].ordering == CHOLMOD_NESDIS;
   lend_values(f);
   numeric_factorization(s);
   plan_substitution(s, precision == FactorPrecision::kScaled32 ? min_scaled_entries : kNever);

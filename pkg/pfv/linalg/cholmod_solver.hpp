@@ -38,6 +38,10 @@ enum class Ordering { kAuto, kAmd, kMetis, kNestedDissection, kCholmod, kGeometr
 // analysis, is kept.
 inline constexpr int kGeometricFrom = 8000;
 
+// Where an elimination order came from: minimum degree (AMD), METIS (or CHOLMOD's nested
+// dissection, built on it) or the geometric dissection. A carried-over order keeps its origin.
+enum class OrderingOrigin { kMinimumDegree, kMetis, kGeometric };
+
 // kScaled32 keeps the factor, computed in double, as 32-bit integers with one double scale per
 // column (in CHOLMOD's array): L(i, j) ~ q(i, j) * max_i |L(i, j)| / (2^31 - 1). Half the memory
 // traffic of a substitution, whose result is then only an approximate inverse, to be used
@@ -57,7 +61,7 @@ enum class FactorPrecision { kDouble, kScaled32 };
 struct GivenOrdering {
   std::vector<int> perm;  // perm[k] = unknown eliminated k-th; empty: none
   double max_fill = 0;
-  bool from_metis = false;  // where the order it descends from came from (for metis_used)
+  OrderingOrigin origin = OrderingOrigin::kMinimumDegree;  // of the order it descends from
   // Ordering::kGeometric: computes the fresh order when none is given or the given one fills too much.
   std::function<std::vector<int>()> geometric;
 };
@@ -100,7 +104,8 @@ class CholmodSolver {
   bool reduced_precision() const { return !scale_.empty(); }  // the kScaled32 format
   double parallel_top_fraction() const { return parallel_.top_fraction(); }
   int shared_top_supernodes() const { return parallel_.shared_top_supernodes(); }
-  bool metis_used() const { return metis_used_; }
+  OrderingOrigin origin() const { return origin_; }
+  bool metis_used() const { return origin_ == OrderingOrigin::kMetis; }
   bool ordering_given() const { return ordering_given_; }  // the given order was kept
   const int* permutation() const;                          // unknown eliminated k-th, after CHOLMOD's postorder
   double fill() const;                                     // factor entries per unknown
@@ -144,7 +149,7 @@ class CholmodSolver {
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
   std::vector<double> scale_;          // per column (elimination order) with kScaled32; empty in double
   ParallelSubstitution parallel_;
-  bool metis_used_ = false;
+  OrderingOrigin origin_ = OrderingOrigin::kMinimumDegree;
   bool ordering_given_ = false;
   double analysis_seconds_ = 0;
 };

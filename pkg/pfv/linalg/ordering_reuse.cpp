@@ -15,12 +15,8 @@ std::array<int, 4> CellOrdering::key_of(const std::array<int, 4>& vertices) {
 }
 
 CellOrdering::CellOrdering(const Mesh& mesh, const PressureSystem& s, const int* perm, SupernodalChains tree,
-                           double fresh_fill, bool from_metis)
-    : n_spheres_(mesh.n_spheres),
-      n_(s.n_unknowns()),
-      tree_(std::move(tree)),
-      fresh_fill_(fresh_fill),
-      from_metis_(from_metis) {
+                           double fresh_fill, OrderingOrigin origin)
+    : n_spheres_(mesh.n_spheres), n_(s.n_unknowns()), tree_(std::move(tree)), fresh_fill_(fresh_fill), origin_(origin) {
   rank_.reserve(static_cast<std::size_t>(n_) * 2);
   for (int k = 0; k < n_; ++k) rank_.emplace(key_of(mesh.cell_vertices[s.unknown_cell[perm[k]]]), k);
 }

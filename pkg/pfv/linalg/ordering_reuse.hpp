@@ -29,13 +29,13 @@ class CellOrdering {
   // eliminated k-th) and tree; fresh_fill = factor entries per unknown of the last ordering
   // computed from scratch (this one, or the one it descends from).
   CellOrdering(const Mesh& mesh, const PressureSystem& system, const int* perm, SupernodalChains tree,
-               double fresh_fill, bool from_metis);
+               double fresh_fill, OrderingOrigin origin);
 
   // The elimination order carried over to a new mesh of the same spheres, or empty if the
   // spheres changed (then nothing can be matched).
   std::vector<int> carry_over(const Mesh& mesh, const PressureSystem& system) const;
   double fresh_fill() const { return fresh_fill_; }
-  bool from_metis() const { return from_metis_; }
+  OrderingOrigin origin() const { return origin_; }
 
  private:
   struct KeyHash {
@@ -53,7 +53,7 @@ class CellOrdering {
   int n_spheres_ = -1, n_ = 0;
   SupernodalChains tree_;
   double fresh_fill_ = 0;
-  bool from_metis_ = false;
+  OrderingOrigin origin_ = OrderingOrigin::kMinimumDegree;
   std::unordered_map<std::array<int, 4>, int, KeyHash> rank_;  // cell (vertex set) -> position
 };
 

@@ -129,7 +129,7 @@ def kappa_rows(results):
         ks, _, es, _ = fem_estimate(r["fem"], "symmetry")
         kn, _, en, _ = fem_estimate(r["fem"], "noslip")
         rows.append({
-            "case": r["case"], "n": r["n"], "porosity": r["porosity"],
+            "case": r["case"], "n": r["n"], "porosity": r["porosity"], "shrink": r["shrink"],
             # the reference: the Richardson estimate where three levels give one, else the finest mesh
             "fem_sym": es if np.isfinite(es) else ks, "fem_noslip": en if np.isfinite(en) else kn,
             "fem_sym_finest": ks, "fem_noslip_finest": kn,
@@ -251,24 +251,53 @@ def figure(rows, path):
     fig.savefig(path, dpi=110)
 
 
+RATIOS = (("pfv_slip", "fem_sym", "PFV slip, thesis"), ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor"),
+          ("pfv_noslip", "fem_noslip", "PFV no-slip"), ("yade_slip", "fem_sym", "YADE slip"),
+          ("yade_noslip", "fem_noslip", "YADE no-slip"))
+
+
+def shrink_limit(shrinks, values):
+    """(value at zero shrink, how it was found) from one quantity at decreasing shrinks: Richardson
+    with the observed order through the last three (as for the mesh levels), else the straight line
+    through the last two, which assumes order 1 and is labelled so."""
+    if len(values) >= 3:
+        q = observed_order(shrinks[-3:], values[-3:])
+        if np.isfinite(q):
+            c = (values[-1] - values[-2]) / (shrinks[-2] ** q - shrinks[-1] ** q)
+            return values[-1] + c * shrinks[-1] ** q, "q = %.1f" % q
+    if len(values) >= 2:
+        s1, s2 = shrinks[-2:]
+        v1, v2 = values[-2:]
+        return v2 - (v1 - v2) * s2 / (s1 - s2), "linear"
+    return float("nan"), ""
+
+
 def shrink_table(rows):
-    """The shrink's effect: each ratio kappa_model / kappa_FEM at the default shrink against the same
-    packing shrunk by another amount (cases named <case>@<shrink>)."""
-    by_case = {w["case"]: w for w in rows}
-    pairs = [(by_case[c.split("@")[0]], w) for c, w in by_case.items() if "@" in c and c.split("@")[0] in by_case]
-    if not pairs:
+    """The shrink's effect: each ratio kappa_model / kappa_FEM of a packing at the default shrink and
+    at the others computed for it (cases named <case>@<shrink>), and its limit at zero shrink, the
+    touching spheres that the shrink stands in for."""
+    by_base = {}
+    for w in rows:
+        base, _, shrink = w["case"].partition("@")
+        by_base.setdefault(base, {})[float(shrink) if shrink else None] = w
+    series = {base: v for base, v in by_base.items() if len(v) > 1 and None in v}
+    if not series:
         return ""
-    lines = ["| case | ratio | shrink 1 %% | shrink %s | difference |" % "/".join(
-        sorted({"%g %%" % (100 * float(w["case"].split("@")[1])) for _, w in pairs})), "|---|---|---|---|---|"]
-    for base, other in pairs:
-        for key, ref, label in (("pfv_slip", "fem_sym", "PFV slip, thesis"), ("pfv_slip_yade", "fem_sym",
-                                "PFV slip, YADE factor"), ("pfv_noslip", "fem_noslip", "PFV no-slip"),
-                                ("yade_slip", "fem_sym", "YADE slip"), ("yade_noslip", "fem_noslip", "YADE no-slip")):
-            a, b = base[key] / base[ref], other[key] / other[ref]
-            lines.append("| %s | %s | %.3f | %.3f | %+.1f %% |" % (base["case"], label, a, b, 100 * (b / a - 1)))
-        lines.append("| %s | κ_FEM sym / no-slip | %.4e / %.4e | %.4e / %.4e | %+.1f %% / %+.1f %% |" % (
-            base["case"], base["fem_sym"], base["fem_noslip"], other["fem_sym"], other["fem_noslip"],
-            100 * (other["fem_sym"] / base["fem_sym"] - 1), 100 * (other["fem_noslip"] / base["fem_noslip"] - 1)))
+    default = {base: v[None]["shrink"] for base, v in series.items()}
+    for base, v in series.items():
+        v[default[base]] = v.pop(None)
+    columns = sorted({s for v in series.values() for s in v}, reverse=True)
+    lines = ["| case | ratio | %s | → 0 | at 1 %% / at 0 |" % " | ".join("shrink %g %%" % (100 * s) for s in columns),
+             "|---|---|%s---|---|" % ("---|" * len(columns))]
+    for base, v in series.items():
+        shrinks = sorted(v, reverse=True)
+        for key, ref, label in RATIOS + (("fem_sym", None, "κ_FEM sym"), ("fem_noslip", None, "κ_FEM no-slip")):
+            values = [v[s][key] / (v[s][ref] if ref else 1) for s in shrinks]
+            limit, how = shrink_limit(shrinks, values)
+            fmt = "%.3f" if ref else "%.4e"
+            cells = [fmt % values[shrinks.index(s)] if s in v else "" for s in columns]
+            lines.append("| %s | %s | %s | %s (%s) | %+.1f %% |" % (
+                base, label, " | ".join(cells), fmt % limit, how, 100 * (values[0] / limit - 1)))
     return "\n".join(lines)
 
 

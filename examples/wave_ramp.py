@@ -7,11 +7,14 @@ p_top = A(t) (1 + cos(pi x / L)), A(t) = rate t.
 
 --bed runs one of the two beds only (two processes run the beds side by side on two cores, each
 with its own --duration: the loose bed fails at a fraction of the dense bed's amplitude); --from
-then reads both records from DIR (with --bed, that bed's only).
+then reads both records from DIR (with --bed, that bed's only), also the time series a run stopped early
+leaves behind (checkpointed as it goes; the grain count then comes from --quick).
 
 Both samples (phi_c1 = 1 and 30 deg; phi_c2 = 30 deg) under the same ramp. A sample becomes unstable
-at the amplitude where the root-mean-square grain velocity sqrt(2 KE / M) first exceeds 1 % of
-sqrt(g d50), the velocity scale of a grain falling by its own size: grains at rest on a stable bed
+at the amplitude where the root-mean-square grain velocity sqrt(2 KE / M) exceeds 1 % of sqrt(g d50),
+the velocity scale of a grain falling by its own size, after having been below it (a bed still
+settling from its deposition when the ramp starts is not yet failing; pfv.diagnostics.instability_onset):
+grains at rest on a stable bed
 move orders of magnitude slower, a failing bed faster (the thesis reads the instability off the jump of
 its KE curve: 1500 Pa dense, about a quarter of that loose). The amplitudes at 0.5 % and 2 % are
 printed beside it to show how much the threshold matters; the ratio dense / loose is printed against
@@ -27,19 +30,15 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: argv[0] is the script
 import seabed_sample  # noqa: E402
 import seabed_wave  # noqa: E402
+from pfv import diagnostics  # noqa: E402
 
 THRESHOLDS = (0.005, 0.01, 0.02)  # of sqrt(g d50); 0.01 is the criterion
 CRITERION = 0.01
 
 
-def instability_amplitudes(t, ke, amplitude, mass, d50):
-    """{threshold: amplitude (Pa) where sqrt(2 KE / mass) first exceeds threshold * sqrt(g d50)}, NaN if never."""
-    v = np.sqrt(2 * np.asarray(ke) / mass) / math.sqrt(seabed_sample.GRAVITY * d50)
-    out = {}
-    for f in THRESHOLDS:
-        above = np.flatnonzero(v > f)
-        out[f] = float(np.asarray(amplitude)[above[0]]) if len(above) else float("nan")
-    return out
+def instability_amplitudes(ke, amplitude, mass, d50):
+    """{threshold: amplitude (Pa) where the bed, once at rest, moves faster than threshold * sqrt(g d50)}."""
+    return {f: diagnostics.instability_onset(amplitude, ke, mass, d50, f, seabed_sample.GRAVITY) for f in THRESHOLDS}
 
 
 def read_record(folder):
@@ -67,9 +66,14 @@ unstable = {}
 for name, friction in BEDS:
     if o["bed"] and name != o["bed"]:
         continue
+    partial = False
     if o["from"]:
-        with open(os.path.join(folder, name, "summary.json")) as f:
-            num = json.load(f)["grains"]
+        summary = os.path.join(folder, name, "summary.json")
+        if os.path.exists(summary):
+            with open(summary) as f:
+                num = json.load(f)["grains"]
+        else:  # a run stopped early leaves its checkpointed time series only (size from --quick)
+            partial = True
     sample = seabed_sample.prepare(num, friction)
     if not o["from"]:
         from yade import plot
@@ -79,7 +83,10 @@ for name, friction in BEDS:
         record = plot.data["t"], plot.data["KE"], plot.data["A"]
     else:
         record = read_record(os.path.join(folder, name))
-    unstable[name] = instability_amplitudes(*record, sample_mass(sample), sample["grains"]["d50"])
+    unstable[name] = instability_amplitudes(record[1], record[2], sample_mass(sample), sample["grains"]["d50"])
+    if partial:
+        print(f"{name}: no summary.json, the run did not finish: its record ends at t = {record[0][-1]:.2f} s, "
+              f"A = {record[2][-1]:.0f} Pa ({num} grains assumed from --quick)")
     print(f"{name} (n = {sample['porosity']:.3f}): unstable at A = {unstable[name][CRITERION]:.0f} Pa "
           f"(thresholds {', '.join(f'{100 * f:g} %: {a:.0f} Pa' for f, a in unstable[name].items())})")
 if o["bed"]:

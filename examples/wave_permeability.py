@@ -9,7 +9,7 @@ shear viscous forces.
 
 The permeability is scaled by FlowEngine.permeabilityFactor (every conductance times the factor), the
 thesis' three unstated Kd values by three factors (default 1/4, 1, 4). For each run: the time the bed
-spends liquefied (mean grad H / i_c over the 30 sensor pairs above 0.8), its final porosity and
+spends liquefied (mean grad H / i_c over the 25 sensor pairs above 0.8), its final porosity and
 settlement, and the largest horizontal displacement on the symmetry axis; the thesis expects no
 liquefaction for the most permeable bed, a duration growing as 1/Kd for the others, and lower final
 porosity for lower Kd. The run at factor 1 is repeated with viscousShear=True: the thesis finds n(t)

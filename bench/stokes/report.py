@@ -26,6 +26,11 @@ THESIS_TABLE_3_2 = {
 }
 
 
+# (model key, FEM key, label) of the ratios kappa_model / kappa_FEM reported, same lateral condition
+RATIOS = (("pfv_slip", "fem_sym", "PFV slip, thesis formula"), ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor"),
+          ("yade_slip", "fem_sym", "YADE slip"), ("pfv_noslip", "fem_noslip", "PFV no-slip"),
+          ("yade_noslip", "fem_noslip", "YADE no-slip"))
+
 # the thesis' mean kappa_HR / kappa_FEM over its packings (section 3.5.3, Fig. 3.12)
 THESIS_MEAN = {"symmetry": 1.01, "noslip": 0.78}
 
@@ -63,13 +68,18 @@ def fem_estimate(levels, lateral):
     if len(k) < 2:
         return k[-1], float("nan"), float("nan"), float("nan")
     change = k[-1] / k[-2] - 1
-    extrapolated = order = float("nan")
-    if len(k) >= 3:
-        order = observed_order(s[-3:], k[-3:])
-        if np.isfinite(order) and order >= MIN_ORDER:
-            c = (k[-1] - k[-2]) / (s[-2] ** order - s[-1] ** order)
-            extrapolated = k[-1] + c * s[-1] ** order
+    extrapolated, order = richardson(s, k) if len(k) >= 3 else (float("nan"), float("nan"))
     return k[-1], change, extrapolated, order
+
+
+def richardson(s, k, min_order=MIN_ORDER):
+    """(value at s = 0, observed order) through the last three of k(s); no value (nan) below
+    min_order or when the changes do not shrink monotonically."""
+    order = observed_order(s[-3:], k[-3:])
+    if not (np.isfinite(order) and order >= min_order):
+        return float("nan"), order
+    c = (k[-1] - k[-2]) / (s[-2] ** order - s[-1] ** order)
+    return k[-1] + c * s[-1] ** order, order
 
 
 def balance(solution):
@@ -156,11 +166,7 @@ def summary(rows):
     cell's power centre shared) and over the random ones, the shrink variants left out."""
     groups = (("regular", lambda c: not c.startswith("random")), ("random", lambda c: c.startswith("random")))
     out = []
-    for key, ref, label in (("pfv_slip", "fem_sym", "PFV slip, thesis formula"),
-                            ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor"),
-                            ("yade_slip", "fem_sym", "YADE slip"),
-                            ("pfv_noslip", "fem_noslip", "PFV no-slip"),
-                            ("yade_noslip", "fem_noslip", "YADE no-slip")):
+    for key, ref, label in RATIOS:
         for group, member in groups:
             q = np.array([w[key] / w[ref] for w in rows if "@" not in w["case"] and member(w["case"])])
             q = q[np.isfinite(q)]
@@ -251,44 +257,38 @@ def figure(rows, path):
     fig.savefig(path, dpi=110)
 
 
-RATIOS = (("pfv_slip", "fem_sym", "PFV slip, thesis"), ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor"),
-          ("pfv_noslip", "fem_noslip", "PFV no-slip"), ("yade_slip", "fem_sym", "YADE slip"),
-          ("yade_noslip", "fem_noslip", "YADE no-slip"))
+# Observed order in the shrink below which no limit at zero shrink is made: kappa is a smooth
+# function of the radii while the spheres do not touch, so order 1 is expected; well below it the
+# three shrinks are not in that range (the 9-sphere packing's cells degenerate as it closes).
+MIN_SHRINK_ORDER = 0.5
 
 
 def shrink_limit(shrinks, values):
     """(value at zero shrink, how it was found) from one quantity at decreasing shrinks: Richardson
-    with the observed order through the last three (as for the mesh levels), else the straight line
-    through the last two, which assumes order 1 and is labelled so."""
+    through the last three (no value below MIN_SHRINK_ORDER), or with two shrinks only the straight
+    line through them, which assumes order 1 and is labelled so."""
     if len(values) >= 3:
-        q = observed_order(shrinks[-3:], values[-3:])
-        if np.isfinite(q):
-            c = (values[-1] - values[-2]) / (shrinks[-2] ** q - shrinks[-1] ** q)
-            return values[-1] + c * shrinks[-1] ** q, "q = %.1f" % q
-    if len(values) >= 2:
-        s1, s2 = shrinks[-2:]
-        v1, v2 = values[-2:]
-        return v2 - (v1 - v2) * s2 / (s1 - s2), "linear"
-    return float("nan"), ""
+        limit, q = richardson(shrinks, values, MIN_SHRINK_ORDER)
+        return limit, ("q = %.1f" % q if np.isfinite(limit) else "none: q = %.1f" % q)
+    s1, s2 = shrinks[-2:]
+    v1, v2 = values[-2:]
+    return v2 - (v1 - v2) * s2 / (s1 - s2), "linear"
 
 
 def shrink_table(rows):
-    """The shrink's effect: each ratio kappa_model / kappa_FEM of a packing at the default shrink and
-    at the others computed for it (cases named <case>@<shrink>), and its limit at zero shrink, the
-    touching spheres that the shrink stands in for."""
+    """The shrink's effect: each ratio kappa_model / kappa_FEM of a packing at every shrink computed
+    for it (the default, and cases named <case>@<shrink>), and its limit at zero shrink, the touching
+    spheres that the shrink stands in for."""
     by_base = {}
     for w in rows:
-        base, _, shrink = w["case"].partition("@")
-        by_base.setdefault(base, {})[float(shrink) if shrink else None] = w
-    series = {base: v for base, v in by_base.items() if len(v) > 1 and None in v}
+        by_base.setdefault(w["case"].partition("@")[0], {})[w["shrink"]] = w
+    series = {base: v for base, v in by_base.items() if len(v) > 1}
     if not series:
         return ""
-    default = {base: v[None]["shrink"] for base, v in series.items()}
-    for base, v in series.items():
-        v[default[base]] = v.pop(None)
     columns = sorted({s for v in series.values() for s in v}, reverse=True)
-    lines = ["| case | ratio | %s | → 0 | at 1 %% / at 0 |" % " | ".join("shrink %g %%" % (100 * s) for s in columns),
-             "|---|---|%s---|---|" % ("---|" * len(columns))]
+    lines = ["| case | ratio | %s | → 0 | at %g %% / at 0 |" % (
+        " | ".join("shrink %g %%" % (100 * s) for s in columns), 100 * columns[0]),
+        "|---|---|%s---|---|" % ("---|" * len(columns))]
     for base, v in series.items():
         shrinks = sorted(v, reverse=True)
         for key, ref, label in RATIOS + (("fem_sym", None, "κ_FEM sym"), ("fem_noslip", None, "κ_FEM no-slip")):
@@ -296,8 +296,9 @@ def shrink_table(rows):
             limit, how = shrink_limit(shrinks, values)
             fmt = "%.3f" if ref else "%.4e"
             cells = [fmt % values[shrinks.index(s)] if s in v else "" for s in columns]
-            lines.append("| %s | %s | %s | %s (%s) | %+.1f %% |" % (
-                base, label, " | ".join(cells), fmt % limit, how, 100 * (values[0] / limit - 1)))
+            lines.append("| %s | %s | %s | %s (%s) | %s |" % (
+                base, label, " | ".join(cells), fmt % limit if np.isfinite(limit) else "–", how,
+                "%+.1f %%" % (100 * (values[0] / limit - 1)) if np.isfinite(limit) else "–"))
     return "\n".join(lines)
 
 

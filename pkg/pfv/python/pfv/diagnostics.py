@@ -118,21 +118,21 @@ def kinetic_energy(vel: np.ndarray, mass: np.ndarray) -> float:
     return 0.5 * float(np.sum(mass * np.einsum("ij,ij->i", vel, vel)))
 
 
-def instability_onset(amplitude: Sequence[float], kinetic_energy: Sequence[float], mass: float, d50: float,
+def instability_onset(amplitude: Sequence[float], energy: Sequence[float], mass: float, d50: float,
                       threshold: float, g: float = G) -> float:
     """The load amplitude at which a bed under a growing load starts to move (thesis 6.3 reads it
     off the jump of its kinetic-energy curve): the first record where the root-mean-square grain
-    velocity sqrt(2 KE / mass) exceeds threshold * sqrt(g d50) after having been at or below it. A
+    velocity sqrt(2 energy / mass) exceeds threshold * sqrt(g d50) after having been at or below it. A
     bed still settling from its deposition when the load starts is not yet unstable, so records
     before it first comes to rest do not count. NaN when it never comes to rest or never moves
     again."""
     a = np.asarray(amplitude, dtype=float)
-    ke = np.asarray(kinetic_energy, dtype=float)
+    ke = np.asarray(energy, dtype=float)
     if a.ndim != 1 or a.shape != ke.shape:
-        raise ValueError(f"amplitude and kinetic_energy must be two records of one length (got shapes "
+        raise ValueError(f"amplitude and energy must be two records of one length (got shapes "
                          f"{a.shape} and {ke.shape})")
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(ke)) and np.all(ke >= 0)):
-        raise ValueError("amplitude and kinetic_energy must be finite, kinetic_energy non-negative")
+        raise ValueError("amplitude and energy must be finite, energy non-negative")
     for name, value in (("mass", mass), ("d50", d50), ("threshold", threshold), ("g", g)):
         if not (math.isfinite(value) and value > 0):
             raise ValueError(f"{name} must be a positive number (got {value!r})")

@@ -128,13 +128,21 @@ RESOLVED = 0.01  # |Q_in - Q_out| / Q of the finest mesh below which a case ente
 
 
 def unresolved(results):
-    return [r["case"] for r in results if max(balance(r["fem"][-1][lat]) for lat in ("symmetry", "noslip")) > RESOLVED]
+    return [r["case"] for r in results
+            if r["fem"] and max(balance(r["fem"][-1][lat]) for lat in ("symmetry", "noslip")) > RESOLVED]
+
+
+def model_kappas(r):
+    """kappa of PFV's three wall variants and YADE's two, keyed as in RATIOS."""
+    return {"pfv_noslip": r["pfv"]["noslip"]["kappa"], "pfv_slip": r["pfv"]["slip"]["kappa"],
+            "pfv_slip_yade": r["pfv"]["slip_yade"]["kappa"],
+            "yade_noslip": yade_kappa(r, "noslip"), "yade_slip": yade_kappa(r, "slip")}
 
 
 def kappa_rows(results):
     rows = []
     for r in results:
-        if r["case"] in unresolved(results):
+        if not r["fem"] or r["case"] in unresolved(results):
             continue
         ks, _, es, _ = fem_estimate(r["fem"], "symmetry")
         kn, _, en, _ = fem_estimate(r["fem"], "noslip")
@@ -142,10 +150,7 @@ def kappa_rows(results):
             "case": r["case"], "n": r["n"], "porosity": r["porosity"], "shrink": r["shrink"],
             # the reference: the Richardson estimate where three levels give one, else the finest mesh
             "fem_sym": es if np.isfinite(es) else ks, "fem_noslip": en if np.isfinite(en) else kn,
-            "fem_sym_finest": ks, "fem_noslip_finest": kn,
-            "pfv_noslip": r["pfv"]["noslip"]["kappa"], "pfv_slip": r["pfv"]["slip"]["kappa"],
-            "pfv_slip_yade": r["pfv"]["slip_yade"]["kappa"],
-            "yade_noslip": yade_kappa(r, "noslip"), "yade_slip": yade_kappa(r, "slip")})
+            "fem_sym_finest": ks, "fem_noslip_finest": kn, **model_kappas(r)})
     return rows
 
 
@@ -217,32 +222,41 @@ def forces_072(results):
     return "\n".join(lines)
 
 
-def figure(rows, path):
+def figure(rows, contact, path):
+    """kappa_model / kappa_FEM against d/D (9 spheres) and per packing, at the touching spheres
+    (contact_rows, filled markers) where the packing's shrink series exists, else at the 1 % shrink
+    (open markers)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    touching = {w["case"]: w for w in contact}
+    shrunk = {w["case"]: w for w in rows if "@" not in w["case"]}
+    chosen = {c: touching.get(c, w) for c, w in shrunk.items()}
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
-    series = sorted([w for w in rows if w["case"].startswith("centred9_") and "@" not in w["case"]],
-                    key=lambda w: float(w["case"].split("_")[1]))
-    x = [float(w["case"].split("_")[1]) for w in series]
-    styles = (("pfv_slip", "fem_sym", "PFV slip, thesis formula", "o-"),
-              ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor", "s--"),
-              ("yade_slip", "fem_sym", "YADE slip", "x:"),
-              ("pfv_noslip", "fem_noslip", "PFV no-slip", "^-"),
-              ("yade_noslip", "fem_noslip", "YADE no-slip", "+:"))
-    for key, ref, label, style in styles:
-        a.plot(x, [w[key] / w[ref] for w in series], style, label=label)
+    styles = (("pfv_slip", "fem_sym", "PFV slip, thesis formula", "o", "-"),
+              ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor", "s", "--"),
+              ("yade_slip", "fem_sym", "YADE slip", "x", ":"),
+              ("pfv_noslip", "fem_noslip", "PFV no-slip", "^", "-"),
+              ("yade_noslip", "fem_noslip", "YADE no-slip", "+", ":"))
+    series = sorted([c for c in chosen if c.startswith("centred9_")], key=lambda c: float(c.split("_")[1]))
+    x = np.array([float(c.split("_")[1]) for c in series])
+    filled = np.array([c in touching for c in series], dtype=bool)
+    packs = [c for c in chosen if not c.startswith("centred9_")] + ["centred9_0.72"]
+    pos = np.arange(len(packs))
+    names = [c.replace("centred9_0.72", "9 (d/D 0.72)").replace("cubic8", "8").replace("random", "") for c in packs]
+    for i, (key, ref, label, marker, line) in enumerate(styles):
+        colour = "C%d" % i
+        y = np.array([chosen[c][key] / chosen[c][ref] for c in series])
+        a.plot(x, y, line, color=colour, label=label)
+        a.plot(x[filled], y[filled], marker, color=colour, ls="none")
+        a.plot(x[~filled], y[~filled], marker, color=colour, ls="none", mfc="none")
+        for p, c in zip(pos, packs):
+            b.plot(p + (i - 2) * 0.06, chosen[c][key] / chosen[c][ref], marker, color=colour,
+                   mfc=colour if c in touching else "none")
     a.axhline(1, color="k", lw=0.5)
     a.set_xlabel("d/D (9-sphere packing)")
     a.set_ylabel("κ / κ_FEM (same lateral condition)")
     a.legend(fontsize=8)
-    packs = [w for w in rows if not w["case"].startswith("centred9_") and "@" not in w["case"]]
-    packs.append(next(w for w in rows if w["case"] == "centred9_0.72"))
-    names = [w["case"].replace("centred9_0.72", "9 (d/D 0.72)").replace("cubic8", "8").replace("random", "")
-             for w in packs]
-    pos = np.arange(len(packs))
-    for i, (key, ref, label, style) in enumerate(styles):
-        b.plot(pos + (i - 2) * 0.06, [w[key] / w[ref] for w in packs], style[0], label=label)
     b.axhline(1, color="k", lw=0.5)
     for ax in (a, b):  # the thesis' means over its cases (section 3.5.3, Fig. 3.12)
         ax.axhline(THESIS_MEAN["symmetry"], color="tab:blue", lw=0.8, ls=(0, (1, 3)))
@@ -253,52 +267,91 @@ def figure(rows, path):
     b.set_xticklabels(names)
     b.set_xlabel("packing (number of spheres)")
     b.set_ylabel("κ / κ_FEM")
+    if not filled.all() or any(c not in touching for c in packs):
+        fig.suptitle("filled: touching spheres (FEM extrapolated in the shrink); open: spheres shrunk by 1 %",
+                     fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
 
-# Observed order in the shrink below which no limit at zero shrink is made: kappa is a smooth
-# function of the radii while the spheres do not touch, so order 1 is expected; well below it the
-# three shrinks are not in that range (the 9-sphere packing's cells degenerate as it closes).
+# Observed order in the shrink below which the FEM gets no limit at zero shrink: kappa is a smooth
+# function of the radii while the spheres do not touch, and order 1 is what the series show; well
+# below it the three shrinks are not in that range.
 MIN_SHRINK_ORDER = 0.5
 
 
-def shrink_limit(shrinks, values):
-    """(value at zero shrink, how it was found) from one quantity at decreasing shrinks: Richardson
-    through the last three (no value below MIN_SHRINK_ORDER), or with two shrinks only the straight
-    line through them, which assumes order 1 and is labelled so."""
-    if len(values) >= 3:
-        limit, q = richardson(shrinks, values, MIN_SHRINK_ORDER)
-        return limit, ("q = %.1f" % q if np.isfinite(limit) else "none: q = %.1f" % q)
-    s1, s2 = shrinks[-2:]
-    v1, v2 = values[-2:]
-    return v2 - (v1 - v2) * s2 / (s1 - s2), "linear"
-
-
-def shrink_table(rows):
-    """The shrink's effect: each ratio kappa_model / kappa_FEM of a packing at every shrink computed
-    for it (the default, and cases named <case>@<shrink>), and its limit at zero shrink, the touching
-    spheres that the shrink stands in for."""
+def shrink_series(rows):
+    """{packing: {shrink: row}} of the packings computed at three shrinks or more."""
     by_base = {}
     for w in rows:
         by_base.setdefault(w["case"].partition("@")[0], {})[w["shrink"]] = w
-    series = {base: v for base, v in by_base.items() if len(v) > 1}
+    return {base: v for base, v in by_base.items() if len(v) >= 3}
+
+
+def contact_rows(rows, results):
+    """The touching spheres that the shrink stands in for: PFV and YADE on the packing itself
+    (run.py --models-only, case <name>@0), against the FEM's limit at zero shrink, Richardson in the
+    shrink through its three smallest shrinks. `<fem>_spread` is the distance of that limit from the
+    straight line through the two smallest shrinks: the extrapolation's own uncertainty."""
+    models = {r["case"].partition("@")[0]: r for r in results if not r["fem"] and r["shrink"] == 0}
+    out = []
+    for base, v in shrink_series(rows).items():
+        if base not in models:
+            continue
+        shrinks = sorted(v, reverse=True)
+        row = {"case": base, "n": models[base]["n"], "porosity": models[base]["porosity"], "shrink": 0.0,
+               **model_kappas(models[base])}
+        for key in ("fem_sym", "fem_noslip"):
+            values = [v[x][key] for x in shrinks]
+            limit, order = richardson(shrinks, values, MIN_SHRINK_ORDER)
+            line = values[-1] - (values[-2] - values[-1]) * shrinks[-1] / (shrinks[-2] - shrinks[-1])
+            row.update({key: limit, key + "_order": order, key + "_spread": line / limit - 1})
+        if np.isfinite(row["fem_sym"]) and np.isfinite(row["fem_noslip"]):
+            out.append(row)
+    return out
+
+
+def shrink_table(rows, contact):
+    """The shrink's effect on each ratio kappa_model / kappa_FEM: its value at every shrink computed
+    (the default, and cases named <case>@<shrink>) and at the touching spheres (contact_rows)."""
+    series = shrink_series(rows)
+    at_contact = {w["case"]: w for w in contact}
     if not series:
         return ""
     columns = sorted({s for v in series.values() for s in v}, reverse=True)
-    lines = ["| case | ratio | %s | → 0 | at %g %% / at 0 |" % (
+    lines = ["| case | quantity | %s | touching | at %g %% / touching |" % (
         " | ".join("shrink %g %%" % (100 * s) for s in columns), 100 * columns[0]),
         "|---|---|%s---|---|" % ("---|" * len(columns))]
     for base, v in series.items():
-        shrinks = sorted(v, reverse=True)
-        for key, ref, label in RATIOS + (("fem_sym", None, "κ_FEM sym"), ("fem_noslip", None, "κ_FEM no-slip")):
-            values = [v[s][key] / (v[s][ref] if ref else 1) for s in shrinks]
-            limit, how = shrink_limit(shrinks, values)
+        touch = at_contact.get(base)
+        for key, ref, label in (("fem_sym", None, "κ_FEM sym"), ("fem_noslip", None, "κ_FEM no-slip")) + RATIOS:
             fmt = "%.3f" if ref else "%.4e"
-            cells = [fmt % values[shrinks.index(s)] if s in v else "" for s in columns]
-            lines.append("| %s | %s | %s | %s (%s) | %s |" % (
-                base, label, " | ".join(cells), fmt % limit if np.isfinite(limit) else "–", how,
-                "%+.1f %%" % (100 * (values[0] / limit - 1)) if np.isfinite(limit) else "–"))
+            cells = [fmt % (v[s][key] / (v[s][ref] if ref else 1)) if s in v else "" for s in columns]
+            if touch is None:
+                limit, how = float("nan"), "–"
+            elif ref:
+                limit, how = touch[key] / touch[ref], fmt % (touch[key] / touch[ref])
+            else:
+                limit = touch[key]
+                how = "%.4e (q = %.1f, ± %.2f %%)" % (limit, touch[key + "_order"], 100 * abs(touch[key + "_spread"]))
+            first = v[columns[0]][key] / (v[columns[0]][ref] if ref else 1) if columns[0] in v else float("nan")
+            lines.append("| %s | %s | %s | %s | %s |" % (
+                base, label, " | ".join(cells), how,
+                "%+.1f %%" % (100 * (first / limit - 1)) if np.isfinite(limit) and np.isfinite(first) else "–"))
+    return "\n".join(lines)
+
+
+def contact_table(contact):
+    """The permeability table at the touching spheres."""
+    lines = ["| case | porosity | κ_FEM sym (→ 0) | PFV slip, thesis / FEM | PFV slip, YADE factor / FEM "
+             "| YADE slip / FEM | κ_FEM no-slip (→ 0) | PFV no-slip / FEM | YADE no-slip / FEM |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for w in contact:
+        sym, ns = w["fem_sym"], w["fem_noslip"]
+        lines.append("| %s | %.3f | %.4e ± %.1f %% | **%.3f** | %.3f | %.3f | %.4e ± %.1f %% | %.3f | %.3f |" % (
+            w["case"], w["porosity"], sym, 100 * abs(w["fem_sym_spread"]), w["pfv_slip"] / sym,
+            w["pfv_slip_yade"] / sym, w["yade_slip"] / sym, ns, 100 * abs(w["fem_noslip_spread"]),
+            w["pfv_noslip"] / ns, w["yade_noslip"] / ns))
     return "\n".join(lines)
 
 
@@ -307,7 +360,8 @@ def main():
     ap.add_argument("--results", default=",".join(os.path.join(HERE, "results", f)
                                                   for f in ("stokes_results.json", "stokes_series.json",
                                                             "stokes_shrink.json", "stokes_random200.json",
-                                                            "stokes_random54.json", "stokes_random_more.json")))
+                                                            "stokes_random54.json", "stokes_random_more.json",
+                                                            "stokes_shrink_random.json", "stokes_contact.json")))
     ap.add_argument("--figure", default=os.path.join(ROOT, "doc", "figures", "stokes-kappa.png"))
     args = ap.parse_args()
     results = {}
@@ -323,10 +377,13 @@ def main():
     left_out = ", ".join(unresolved(results)) or "none"
     print("\nleft out, the finest mesh's flux balance above %g: %s" % (RESOLVED, left_out))
     print("\n## summary\n\n" + summary(rows))
-    print("\n## shrink\n\n" + shrink_table(rows))
+    contact = contact_rows(rows, list(results))
+    print("\n## shrink\n\n" + shrink_table(rows, contact))
+    print("\n## touching spheres\n\n" + contact_table(contact))
+    print("\n## summary, touching spheres\n\n" + summary(contact))
     print("\n## forces, 9 spheres, d/D = 0.72, no-slip\n\n" + forces_072(results))
     if any(w["case"].startswith("centred9_") for w in rows):
-        figure(rows, args.figure)
+        figure(rows, contact, args.figure)
         print("\nfigure:", args.figure)
 
 

@@ -2,6 +2,7 @@
 
     /usr/bin/python3 bench/stokes/run.py [--cases=a,b] [--levels=0.048,0.034,0.024] [--out=FILE]
     /usr/bin/python3 bench/stokes/run.py --quick [--write-reference]
+    /usr/bin/python3 bench/stokes/run.py --models-only --cases=cubic8@0,random25@0 --out=FILE
 
 Needs the pfv package on PYTHONPATH (a build tree's python/ folder) and, for the YADE column,
 yade-double on PATH. For every case and every sphere-surface element size of --levels (mesh.py)
@@ -12,6 +13,10 @@ pfv_model.py) and YADE's engine (yade_model.py) on the same spheres. Results are
 --quick runs the CI case: the 8-sphere packing on one coarse mesh, solved directly and (symmetry faces)
 by MINRES; with --write-reference it writes tests/data/stokes_fem_quick.json, else it compares with
 that file and exits 1 on a difference larger than its tolerances.
+
+--models-only runs PFV and YADE without the FEM: on the touching spheres themselves (shrink 0, "@0"),
+which the models take as they come and the FEM reaches only as the limit of its shrink series
+(report.py).
 """
 import argparse
 import json
@@ -165,6 +170,8 @@ def main():
                     help="MUMPS' LDL^T, or MINRES with a block AMG preconditioner (memory O(DOFs); solve.py)")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--write-reference", action="store_true")
+    ap.add_argument("--models-only", action="store_true",
+                    help="PFV and YADE only, no FEM (for the touching spheres, cases <name>@0)")
     ap.add_argument("--yade-only", action="store_true",
                     help="rerun YADE's engine only, into the cases already in --out")
     args = ap.parse_args()
@@ -195,7 +202,7 @@ def main():
             json.dump(results, f, indent=1)
         return 0
 
-    levels = [float(x) for x in args.levels.split(",")]
+    levels = [] if args.models_only else [float(x) for x in args.levels.split(",")]
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     results = []
     if os.path.exists(args.out):

@@ -183,42 +183,64 @@ def summary(rows):
                       "|---|---|---|---|---|---|"] + out)
 
 
-def forces_072(results):
-    r = next((x for x in results if x["case"] == "centred9_0.72"), None)
-    if r is None:
-        return ""
-    fem = r["fem"][-1]["noslip"]["forces"]
-    pfv = r["pfv"]["noslip"]["forces"]
-
-    def parts(f, name, part, axis):
-        if part == "total":
+def force_quantities(f):
+    """The quantities of thesis Table 3.2 from one force dictionary (pfv_model / solve.py), / (S dP)."""
+    def part(name, which, axis):
+        if which == "total":
             return f[name]["pressure"][axis] + f[name]["viscous"][axis]
-        return f[name][part][axis]
+        return f[name][which][axis]
 
-    def big(f, part):
-        return np.mean([parts(f, "sphere%d" % k, part, 1) for k in range(8)])
+    def big(which):
+        return np.mean([part("sphere%d" % k, which, 1) for k in range(8)])
 
-    def solid(f):
-        solids = [k for k in f if k.startswith("sphere") or k in ("xmin", "xmax", "zmin", "zmax")]
-        return sum(parts(f, k, "total", 1) for k in solids)
-
-    ours = {
-        "big sphere, viscous y": (big(fem, "viscous"), big(pfv, "viscous")),
-        "big sphere, pressure y": (big(fem, "pressure"), big(pfv, "pressure")),
-        "big sphere, total y": (big(fem, "total"), big(pfv, "total")),
-        "small sphere, viscous y": (parts(fem, "sphere8", "viscous", 1), parts(pfv, "sphere8", "viscous", 1)),
-        "small sphere, pressure y": (parts(fem, "sphere8", "pressure", 1), parts(pfv, "sphere8", "pressure", 1)),
-        "small sphere, total y": (parts(fem, "sphere8", "total", 1), parts(pfv, "sphere8", "total", 1)),
-        "boundary x=0, viscous y": (parts(fem, "xmin", "viscous", 1), parts(pfv, "xmin", "viscous", 1)),
-        "boundary x=0, pressure x": (-parts(fem, "xmin", "pressure", 0), -parts(pfv, "xmin", "pressure", 0)),
-        "solid phase, total y": (solid(fem), solid(pfv)),
+    solids = [k for k in f if k.startswith("sphere") or k in ("xmin", "xmax", "zmin", "zmax")]
+    return {
+        "big sphere, viscous y": big("viscous"), "big sphere, pressure y": big("pressure"),
+        "big sphere, total y": big("total"),
+        "small sphere, viscous y": part("sphere8", "viscous", 1),
+        "small sphere, pressure y": part("sphere8", "pressure", 1),
+        "small sphere, total y": part("sphere8", "total", 1),
+        "boundary x=0, viscous y": part("xmin", "viscous", 1),
+        "boundary x=0, pressure x": -part("xmin", "pressure", 0),
+        "solid phase, total y": sum(part(k, "total", 1) for k in solids),
     }
-    lines = ["| force / (S ΔP) | FEM (here) | PFV (here) | PFV / FEM | thesis FEM | thesis PFV "
-             "| thesis PFV / FEM |",
-             "|---|---|---|---|---|---|---|"]
-    for name, (f, p) in ours.items():
+
+
+def forces_072(results):
+    """Thesis Table 3.2: FEM (finest mesh) and PFV on the 9 spheres at d/D = 0.72, no-slip lateral
+    faces, at the 1 % shrink; and at the touching spheres where the shrink series exists: PFV on
+    the packing itself, the FEM forces extrapolated in the shrink like kappa (contact_rows)."""
+    by_case = {r["case"]: r for r in results}
+    r = by_case.get("centred9_0.72")
+    if r is None or not r["fem"]:
+        return ""
+    fem = force_quantities(r["fem"][-1]["noslip"]["forces"])
+    pfv = force_quantities(r["pfv"]["noslip"]["forces"])
+    shrinks = sorted((x["shrink"], x) for x in results
+                     if x["case"].partition("@")[0] == "centred9_0.72" and x["fem"])[::-1]
+    touching = by_case.get("centred9_0.72@0")
+    contact = None
+    if len(shrinks) >= 3 and touching is not None:
+        series = [force_quantities(x["fem"][-1]["noslip"]["forces"]) for _, x in shrinks]
+        fem0 = {k: richardson([s for s, _ in shrinks], [q[k] for q in series], MIN_SHRINK_ORDER)[0] for k in fem}
+        contact = (fem0, force_quantities(touching["pfv"]["noslip"]["forces"]), series[-1])
+    head = "| force / (S ΔP) | FEM (here) | PFV (here) | PFV / FEM |"
+    rule = "|---|---|---|---|"
+    if contact:
+        head += " FEM touching | PFV touching | PFV / FEM touching |"
+        rule += "---|---|---|"
+    lines = [head + " thesis FEM | thesis PFV | thesis PFV / FEM |", rule + "---|---|---|"]
+    for name in fem:
         tf, tp = THESIS_TABLE_3_2[name]
-        lines.append("| %s | %.4g | %.4g | %.3f | %.4g | %.4g | %.3f |" % (name, f, p, p / f, tf, tp, tp / tf))
+        cells = "| %s | %.4g | %.4g | %.3f |" % (name, fem[name], pfv[name], pfv[name] / fem[name])
+        if contact:
+            f0, p0 = contact[0][name], contact[1][name]
+            if np.isfinite(f0):
+                cells += " %.4g | %.4g | %.3f |" % (f0, p0, p0 / f0)
+            else:  # no monotone change with the shrink: the smallest shrink's value, marked
+                f0 = contact[2][name]
+                cells += " %.4g (at %g %%) | %.4g | %.3f |" % (f0, 100 * shrinks[-1][0], p0, p0 / f0)
+        lines.append(cells + " %.4g | %.4g | %.3f |" % (tf, tp, tp / tf))
     return "\n".join(lines)
 
 

@@ -16,6 +16,20 @@ Vec3 unit_or_zero(const Vec3& v) {
   return n > 0 ? Vec3(v / n) : Vec3::Zero();
 }
 
+// Power centres of two cells closer than this, relative to their coordinates and the facet's
+// size, are one point computed twice: cells of cospherical spheres (a cubic lattice) share
+// their centre, which floating point returns with a difference of a few ulps, or none. A
+// genuine throat this short would be clamped to the largest conductance all the same.
+constexpr double kCoincidentCentres = 1e-10;
+// Half-height of the thin bipyramid whose wetted areas stand for those of a zero-length throat,
+// relative to the facet's size: the areas are linear in it, their ratios are its limit.
+constexpr double kThinThroat = 1e-6;
+
+bool coincident_centres(const Vec3& a, const Vec3& b, double facet_area) {
+  const double scale = std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), std::sqrt(facet_area)});
+  return (a - b).norm() <= kCoincidentCentres * scale;
+}
+
 // A facet seen as a planar polygon: the triangle of three spheres, or its limit when one
 // or two vertices are walls (a trapezoid or a rectangle reaching the wall planes).
 struct FacetPolygon {
@@ -279,6 +293,16 @@ FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells
       height[1] = nrm.dot(apex[1] - x0);
       sides = 2;
       g.length[f] = (apex[1] - Pi).norm();
+      if (coincident_centres(Pi, apex[1], area)) {
+        // One pore cut in two by an arbitrary facet (cospherical spheres): its length is 0, and
+        // the flat bipyramid between the centres would give phi and gamma as round-off, 0/0, so
+        // the wetted areas are those of a thin bipyramid on the centre's foot in the facet.
+        g.length[f] = 0;
+        const double delta = kThinThroat * std::sqrt(area);
+        const Vec3 foot = Pi + height[0] * nrm;
+        apex = {foot - delta * nrm, foot + delta * nrm};
+        height = {delta, delta};
+      }
     } else {
       g.length[f] = 0;
     }

@@ -244,6 +244,28 @@ def forces_072(results):
     return "\n".join(lines)
 
 
+def centre_sphere_table(results):
+    """The centre sphere of the 9-sphere series against d/D (thesis Fig. 3.15): its force along the
+    flow, total and viscous part, FEM (finest mesh) and PFV, both lateral conditions (PFV's slip walls
+    with YADE's factor), at the 1 % shrink."""
+    series = sorted((float(r["case"].split("_")[1]), r) for r in results
+                    if r["case"].startswith("centred9_") and "@" not in r["case"] and r["fem"])
+    if not series:
+        return ""
+    lines = ["| d/D | FEM total, sym | PFV / FEM, sym | FEM total, no-slip | PFV / FEM, no-slip "
+             "| viscous share FEM / PFV, no-slip |", "|---|---|---|---|---|---|"]
+    for x, r in series:
+        cells = []
+        for lateral, variant in (("symmetry", "slip_yade"), ("noslip", "noslip")):
+            f = r["fem"][-1][lateral]["forces"]["sphere8"]
+            p = r["pfv"][variant]["forces"]["sphere8"]
+            fem, pfv = f["pressure"][1] + f["viscous"][1], p["pressure"][1] + p["viscous"][1]
+            cells += ["%.4g" % fem, "%.3f" % (pfv / fem)]
+        share = (f["viscous"][1] / fem, p["viscous"][1] / pfv)
+        lines.append("| %.2f | %s | %.3f / %.3f |" % (x, " | ".join(cells), share[0], share[1]))
+    return "\n".join(lines)
+
+
 def figure(rows, contact, path):
     """kappa_model / kappa_FEM against d/D (9 spheres) and per packing, at the touching spheres
     (contact_rows, filled markers) where the packing's shrink series exists, else at the 1 % shrink
@@ -404,6 +426,7 @@ def main():
     print("\n## touching spheres\n\n" + contact_table(contact))
     print("\n## summary, touching spheres\n\n" + summary(contact))
     print("\n## forces, 9 spheres, d/D = 0.72, no-slip\n\n" + forces_072(results))
+    print("\n## centre sphere against d/D\n\n" + centre_sphere_table(results))
     if any(w["case"].startswith("centred9_") for w in rows):
         figure(rows, contact, args.figure)
         print("\nfigure:", args.figure)

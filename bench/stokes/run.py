@@ -173,7 +173,9 @@ def main():
     ap.add_argument("--models-only", action="store_true",
                     help="PFV and YADE only, no FEM (for the touching spheres, cases <name>@0)")
     ap.add_argument("--yade-only", action="store_true",
-                    help="rerun YADE's engine only, into the cases already in --out")
+                    help="rerun YADE's engine only, into the cases already in --out (--cases=all: every one)")
+    ap.add_argument("--pfv-only", action="store_true",
+                    help="rerun PFV only, into the cases already in --out (--cases=all: every one)")
     args = ap.parse_args()
     if args.quick:
         now = quick_numbers()
@@ -191,13 +193,20 @@ def main():
         print("%d passed, %d failed" % (len(rows) - failed, failed))
         return 1 if failed else 0
 
-    if args.yade_only:
+    if args.yade_only or args.pfv_only:
         with open(args.out) as f:
             results = json.load(f)
+        chosen = args.cases.split(",") if args.cases != "all" else [r["case"] for r in results]
         for r in results:
-            if r["case"] in args.cases.split(","):
+            if r["case"] not in chosen:
+                continue
+            if args.yade_only:
                 r["yade"] = run_yade(case_packing(r["case"]))
                 print(r["case"], "YADE kappa", {k: v.get("kappa") for k, v in r["yade"].items()}, flush=True)
+            else:
+                packing = case_packing(r["case"])
+                r["pfv"] = {variant: pfv_model.run(packing, variant) for variant in pfv_model.VARIANTS}
+                print(r["case"], "PFV kappa", {k: v["kappa"] for k, v in r["pfv"].items()}, flush=True)
         with open(args.out, "w") as f:
             json.dump(results, f, indent=1)
         return 0

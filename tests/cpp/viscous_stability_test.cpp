@@ -80,3 +80,36 @@ TEST(ViscousStability, ArnoldiAndPowerIterationMatchTheDenseSpectrum) {
   // spectrum, i.e. a limit above the true one (why the engine keeps a safety factor).
   EXPECT_GE(e.viscous_stability_limit(mass, 3), 2 / ref.lambda_max * (1 - 1e-9));
 }
+
+// dV/dt enters the operator by a difference of the cell volumes: a step too large leaves their
+// curvature in the result, one too small its round-off. Either breaks linearity, which a
+// linearised operator must have: A(v + 3w) = A(v) + 3 A(w), and A(2v) = 2 A(v).
+TEST(ViscousStability, TheOperatorIsLinearInTheVelocities) {
+  const auto p = test::random_packing(120, 5, 0.06, 0.09);
+  FlowEngine e = test::permeameter(1);
+  e.step(p.centre, p.radius, p.walls, 1e-4);
+  e.step(p.centre, p.radius, p.walls, 1e-4);
+  const int n = static_cast<int>(p.radius.size());
+  std::vector<double> mass(n, 1.0);
+  std::vector<Vec3> v(n), w(n), sum(n), twice(n);
+  for (int k = 0; k < n; ++k) {
+    v[k] = Vec3(std::sin(0.3 + k), std::cos(1.1 * k), std::sin(2.0 * k + 0.7));
+    w[k] = k % 7 == 0 ? Vec3(1.0, -2.0, 0.5) : Vec3::Zero();  // a few spheres only: widely different speeds
+    sum[k] = v[k] + 3 * w[k];
+    twice[k] = 2 * v[k];
+  }
+  std::vector<Vec3> av, aw, asum, atwice;
+  e.apply_viscous_operator(mass, v, av);
+  e.apply_viscous_operator(mass, w, aw);
+  e.apply_viscous_operator(mass, sum, asum);
+  e.apply_viscous_operator(mass, twice, atwice);
+  double scale = 0, additivity = 0, homogeneity = 0;
+  for (int k = 0; k < n; ++k) {
+    scale = std::max(scale, asum[k].norm());
+    additivity = std::max(additivity, (asum[k] - av[k] - 3 * aw[k]).norm());
+    homogeneity = std::max(homogeneity, (atwice[k] - 2 * av[k]).norm());
+  }
+  ASSERT_GT(scale, 0);
+  EXPECT_LT(additivity, 1e-6 * scale);
+  EXPECT_LT(homogeneity, 1e-6 * scale);
+}

@@ -42,26 +42,25 @@ Graph symmetric_pattern(const PressureSystem& s) {
 }
 
 // Dinic's maximum flow, for the small band graphs of the separators; the storage is kept from
-// one graph to the next. The search for augmenting paths is iterative: a path may be long.
+// one graph to the next. Each node's arcs are stored together (built from the added edges by a
+// counting sort): the breadth-first searches of the phases then read memory in order, where
+// arcs linked into per-node lists as they were added lie scattered over the band. The search
+// for augmenting paths is iterative: a path may be long.
 class MaxFlow {
  public:
   static constexpr int kInfinite = 1 << 30;
 
   void reset(int nodes) {
-    head_.assign(nodes, -1);
-    to_.clear();
-    cap_.clear();
-    next_.clear();
+    nodes_ = nodes;
+    added_.clear();
   }
 
-  void add(int a, int b, int cap) {
-    link(a, b, cap);
-    link(b, a, 0);
-  }
+  void add(int a, int b, int cap) { added_.push_back({a, b, cap}); }
 
   void run(int source, int sink) {
+    arrange();
     while (levels(source, sink)) {
-      edge_ = head_;
+      edge_.assign(start_.begin(), start_.end() - 1);
       while (augment(source, sink)) {
       }
     }
@@ -72,22 +71,43 @@ class MaxFlow {
   bool reached(int node) const { return level_[node] >= 0; }
 
  private:
-  void link(int a, int b, int cap) {
-    to_.push_back(b);
-    cap_.push_back(cap);
-    next_.push_back(head_[a]);
-    head_[a] = static_cast<int>(to_.size()) - 1;
+  struct Edge {
+    int from, to, cap;
+  };
+
+  // The added edges and their reverse arcs (capacity 0), grouped by the node they leave.
+  void arrange() {
+    start_.assign(nodes_ + 1, 0);
+    for (const Edge& e : added_) {
+      ++start_[e.from + 1];
+      ++start_[e.to + 1];
+    }
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    const std::size_t arcs = 2 * added_.size();
+    to_.resize(arcs);
+    cap_.resize(arcs);
+    reverse_.resize(arcs);
+    fill_.assign(start_.begin(), start_.end() - 1);
+    for (const Edge& e : added_) {
+      const int forward = fill_[e.from]++, backward = fill_[e.to]++;
+      to_[forward] = e.to;
+      cap_[forward] = e.cap;
+      reverse_[forward] = backward;
+      to_[backward] = e.from;
+      cap_[backward] = 0;
+      reverse_[backward] = forward;
+    }
   }
 
   // Breadth-first levels from the source; nodes no nearer than the sink are not expanded.
   bool levels(int source, int sink) {
-    level_.assign(head_.size(), -1);
+    level_.assign(nodes_, -1);
     level_[source] = 0;
     queue_.assign(1, source);
     for (std::size_t q = 0; q < queue_.size(); ++q) {
       const int a = queue_[q];
       if (level_[sink] >= 0 && level_[a] >= level_[sink]) break;
-      for (int e = head_[a]; e >= 0; e = next_[e])
+      for (int e = start_[a]; e < start_[a + 1]; ++e)
         if (cap_[e] > 0 && level_[to_[e]] < 0) {
           level_[to_[e]] = level_[a] + 1;
           queue_.push_back(to_[e]);
@@ -96,14 +116,14 @@ class MaxFlow {
     return level_[sink] >= 0;
   }
 
-  // One augmenting path along increasing levels (edge_[a]: the next edge of a to try).
+  // One augmenting path along increasing levels (edge_[a]: the next arc of a to try).
   bool augment(int source, int sink) {
     path_.clear();
     int a = source;
     while (a != sink) {
       int& e = edge_[a];
-      while (e >= 0 && (cap_[e] <= 0 || level_[to_[e]] != level_[a] + 1)) e = next_[e];
-      if (e >= 0) {
+      while (e < start_[a + 1] && (cap_[e] <= 0 || level_[to_[e]] != level_[a] + 1)) ++e;
+      if (e < start_[a + 1]) {
         path_.push_back(e);
         a = to_[e];
       } else {
@@ -111,19 +131,21 @@ class MaxFlow {
         level_[a] = -2;  // a dead end for the rest of this phase
         path_.pop_back();
         a = path_.empty() ? source : to_[path_.back()];
-        edge_[a] = next_[edge_[a]];
+        ++edge_[a];
       }
     }
     int f = kInfinite;
     for (int e : path_) f = std::min(f, cap_[e]);
     for (int e : path_) {
       cap_[e] -= f;
-      cap_[e ^ 1] += f;
+      cap_[reverse_[e]] += f;
     }
     return true;
   }
 
-  std::vector<int> head_, to_, cap_, next_, level_, edge_, queue_, path_;
+  int nodes_ = 0;
+  std::vector<Edge> added_;
+  std::vector<int> start_, fill_, to_, cap_, reverse_, level_, edge_, queue_, path_;
 };
 
 class Dissection {

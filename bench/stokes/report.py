@@ -395,9 +395,10 @@ def main():
     ap.add_argument("--results", default=",".join(os.path.join(HERE, "results", f)
                                                   for f in ("stokes_results.json", "stokes_series.json",
                                                             "stokes_shrink.json", "stokes_random200.json",
-                                                            "stokes_random54.json", "stokes_random_more.json", "stokes_random54s2.json",
-                                                            "stokes_shrink_random.json", "stokes_shrink_random54.json",
-                                                            "stokes_shrink_series.json", "stokes_contact.json")))
+                                                            "stokes_random54.json", "stokes_random_more.json",
+                                                            "stokes_random54s2.json", "stokes_shrink_random.json",
+                                                            "stokes_shrink_random54.json", "stokes_shrink_series.json",
+                                                            "stokes_shrink_series2.json", "stokes_contact.json")))
     ap.add_argument("--figure", default=os.path.join(ROOT, "doc", "figures", "stokes-kappa.png"))
     args = ap.parse_args()
     results = {}

@@ -673,15 +673,15 @@ def startup_summary(data):
     return rows
 
 
-def startup_report(opts, machine, rows, command, started, finished, threads):
+def startup_report(opts, machine, rows, command, threads):
     L = []
     w = L.append
-    w('Command: `%s` (%s to %s, %s, `yade -j%d`, OMP_NUM_THREADS = OPENBLAS_NUM_THREADS = %d). Scene and trials as in '
+    w('Command: `%s` (%s, `yade -j%d`, OMP_NUM_THREADS = OPENBLAS_NUM_THREADS = %d). Scene and trials as in '
       'the full benchmark (permeameter, CHOLMOD, no automatic remesh), %d rounds of YADE and PFV interleaved, %d '
       'steady steps. **first step** = engine execTime of the first %d steps of a fresh engine minus %d steady flow '
       'steps, **remesh** = the same from a forced remesh (`updateTriangulation=True`) of that engine; medians over '
       'rounds of the per-trial values (the ratio first/remesh per trial). Targets: first/remesh <= 1.2, first PFV / '
-      'first YADE <= 0.5.' % (command, started, finished, machine.get('Model name', '?'), threads, threads,
+      'first YADE <= 0.5.' % (command, machine.get('Model name', '?'), threads, threads,
                               opts['rounds'], opts['steady'], WINDOW, WINDOW - 1))
     w('')
     w('| N | cells | first step YADE | first step PFV | remesh PFV | **first / remesh PFV** (range) | '
@@ -712,7 +712,6 @@ def startup_report(opts, machine, rows, command, started, finished, threads):
 
 
 def startup_driver(opts, argv):
-    started = datetime.datetime.now().strftime('%Y-%m-%d %H:%M')
     command = 'yade-double -n -x bench/flow_benchmark.py ' + ' '.join(argv)
     machine = machine_description()
     for n in opts['sizes']:
@@ -727,8 +726,7 @@ def startup_driver(opts, argv):
         raw[str(t)] = data
         machine['load average at end'] = ' '.join('%.2f' % x for x in os.getloadavg())
         rows = startup_summary(data)
-        finished = datetime.datetime.now().strftime('%Y-%m-%d %H:%M')
-        texts.append(startup_report(opts, machine, rows, command, started, finished, t))
+        texts.append(startup_report(opts, machine, rows, command, t))
     text = '\n\n'.join(texts)
     print('\n' + text + '\n', flush=True)
     write_report(opts['out'], text, STARTUP_BEGIN_MARK, STARTUP_END_MARK)
@@ -1010,13 +1008,12 @@ def slope(ns, ts):
     return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx if sxx else float('nan')
 
 
-def report(opts, machine, packings, summ, mem, command, started, finished):
+def report(opts, machine, packings, summ, mem, command):
     L = []
     w = L.append
-    w('## Run of %s' % started)
+    w('## Run')
     w('')
-    w('Command: `%s` (%s, finished %s).' % (command, 'quick mode' if opts['quick'] else
-                                            '%d rounds' % opts['rounds'], finished))
+    w('Command: `%s` (%s).' % (command, 'quick mode' if opts['quick'] else '%d rounds' % opts['rounds']))
     w('')
     w('Machine and software:')
     w('')
@@ -1029,9 +1026,9 @@ def report(opts, machine, packings, summ, mem, command, started, finished):
     w('|---|---|---|---|---|---|')
     for n in sorted(packings):
         m = packings[n]
-        w('| %d | %.4f | %.4f | %.4f / %.4f / %.4f | %d iter, %.0f s (-j%s, %s) | `%s` |'
+        w('| %d | %.4f | %.4f | %.4f / %.4f / %.4f | %d iter, %.0f s (-j%s) | `%s` |'
           % (n, m['box'], m['porosity'], m['r_min'], m['r_mean'], m['r_max'], m['iterations'], m['seconds'],
-             m.get('threads', '?'), m.get('date', '?'), m.get('digest', '?')))
+             m.get('threads', '?'), m.get('digest', '?')))
     w('')
     w('Scene: permeameter along y (dp = %g Pa, viscosity %g, p = 0 at ymax), six fixed walls (boundaries at the walls),'
       ' dynamic spheres with friction 30 deg, Newton damping 0.2, no gravity, O.dt = 0.5 P-wave step; the packing is '
@@ -1373,7 +1370,7 @@ def driver(opts, argv):
         log('WARNING: pfv was reinstalled during the run: %s' % builds)
     machine['load average at end'] = ' '.join('%.2f' % x for x in os.getloadavg())
     summ, mem = summarise(timing, memory)
-    text = report(opts, machine, {n: packings[n] for n in opts['sizes']}, summ, mem, command, started, finished)
+    text = report(opts, machine, {n: packings[n] for n in opts['sizes']}, summ, mem, command)
     print('\n' + text + '\n', flush=True)
     write_report(opts['out'], text)
     os.makedirs(os.path.dirname(os.path.abspath(opts['json'])), exist_ok=True)
@@ -1417,11 +1414,7 @@ def pfv_fingerprint():
     mod = sys.modules.get('pfv._core')
     if mod is None:
         return None
-    path = getattr(mod, '__file__', '?')
-    try:
-        return '%s (modified %s)' % (path, datetime.datetime.fromtimestamp(os.path.getmtime(path)).isoformat(' ', 'seconds'))
-    except OSError:
-        return path
+    return getattr(mod, '__file__', '?')
 
 
 if __name__ == '__main__' and 'yade' in sys.modules:

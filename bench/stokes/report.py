@@ -258,16 +258,17 @@ def centre_sphere_table(results):
                     if r["case"].startswith("centred9_") and "@" not in r["case"] and r["fem"])
     if not series:
         return ""
-    lines = ["| d/D | FEM total, sym | PFV / FEM, sym | FEM total, no-slip | PFV / FEM, no-slip "
-             "| viscous part FEM / PFV, no-slip |", "|---|---|---|---|---|---|"]
+    lines = ["| d/D | FEM total, sym [10⁻³ S ΔP] | PFV / FEM, sym | FEM total, no-slip [10⁻³ S ΔP] "
+             "| PFV / FEM, no-slip | viscous part FEM / PFV, no-slip [10⁻³ S ΔP] |", "|---|---|---|---|---|---|"]
     for x, r in series:
         cells = []
         for lateral, variant in (("symmetry", "slip_yade"), ("noslip", "noslip")):
             f = r["fem"][-1][lateral]["forces"]["sphere8"]
             p = r["pfv"][variant]["forces"]["sphere8"]
             fem, pfv = f["pressure"][1] + f["viscous"][1], p["pressure"][1] + p["viscous"][1]
-            cells += ["%.4g" % fem, "%.3f" % (pfv / fem)]
-        lines.append("| %.2f | %s | %.4g / %.4g |" % (x, " | ".join(cells), f["viscous"][1], p["viscous"][1]))
+            cells += ["%.4g" % (1e3 * fem), "%.3f" % (pfv / fem)]
+        viscous = (1e3 * f["viscous"][1], 1e3 * p["viscous"][1])
+        lines.append("| %.2f | %s | %.4g / %.4g |" % ((x, " | ".join(cells)) + viscous))
     return "\n".join(lines)
 
 

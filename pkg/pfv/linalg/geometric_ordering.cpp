@@ -2,6 +2,9 @@
 
 #include <suitesparse/camd.h>
 
+#include <boost/graph/boykov_kolmogorov_max_flow.hpp>
+#include <boost/graph/compressed_sparse_row_graph.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -41,11 +44,13 @@ Graph symmetric_pattern(const PressureSystem& s) {
   return g;
 }
 
-// Dinic's maximum flow, for the small band graphs of the separators; the storage is kept from
-// one graph to the next. Each node's arcs are stored together (built from the added edges by a
-// counting sort): the breadth-first searches of the phases then read memory in order, where
-// arcs linked into per-node lists as they were added lie scattered over the band. The search
-// for augmenting paths is iterative: a path may be long.
+// The maximum flow of a band graph and the source's side of its minimum cut. The flow is
+// Boykov and Kolmogorov's algorithm (Boost.Graph): it grows search trees from both terminals
+// and keeps them between augmentations, where a phase of Dinic's algorithm searches the whole
+// band again; on these grid-like bands it needs a fraction of the time (doc/solvers.md). The cut
+// is read by a breadth-first search of the residual graph from the source: the set it reaches
+// is the same for every maximum flow (the minimum cut nearest the source), so the separator
+// does not depend on how the flow was found. The storage is kept from one band to the next.
 class MaxFlow {
  public:
   static constexpr int kInfinite = 1 << 30;
@@ -59,23 +64,37 @@ class MaxFlow {
 
   void run(int source, int sink) {
     arrange();
-    while (levels(source, sink)) {
-      edge_.assign(start_.begin(), start_.end() - 1);
-      while (augment(source, sink)) {
-      }
-    }
+    using Graph = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
+                                                     boost::no_property, int, int>;
+    using EdgeRef = Graph::edge_descriptor;
+    const Graph g(boost::edges_are_sorted, arc_.begin(), arc_.end(), nodes_);
+    reverse_arc_.resize(arc_.size());
+    for (std::size_t e = 0; e < arc_.size(); ++e) reverse_arc_[e] = EdgeRef(arc_[e].second, reverse_[e]);
+    predecessor_.resize(nodes_);
+    colour_.resize(nodes_);
+    distance_.resize(nodes_);
+    const auto edge = boost::get(boost::edge_index, g);
+    const auto vertex = boost::get(boost::vertex_index, g);
+    boost::boykov_kolmogorov_max_flow(
+        g, boost::make_iterator_property_map(cap_.begin(), edge), boost::make_iterator_property_map(res_.begin(), edge),
+        boost::make_iterator_property_map(reverse_arc_.begin(), edge),
+        boost::make_iterator_property_map(predecessor_.begin(), vertex),
+        boost::make_iterator_property_map(colour_.begin(), vertex),
+        boost::make_iterator_property_map(distance_.begin(), vertex), vertex, source, sink);
+    reach(source);
   }
 
   // Whether the source reaches 'node' in the residual graph, after run(): the source's side of
   // a minimum cut.
-  bool reached(int node) const { return level_[node] >= 0; }
+  bool reached(int node) const { return reached_[node] != 0; }
 
  private:
   struct Edge {
     int from, to, cap;
   };
 
-  // The added edges and their reverse arcs (capacity 0), grouped by the node they leave.
+  // The added edges and their reverse arcs (capacity 0), grouped by the node they leave: the
+  // arcs sorted by source, as the compressed graph takes them.
   void arrange() {
     start_.assign(nodes_ + 1, 0);
     for (const Edge& e : added_) {
@@ -84,68 +103,46 @@ class MaxFlow {
     }
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
     const std::size_t arcs = 2 * added_.size();
-    to_.resize(arcs);
+    arc_.resize(arcs);
     cap_.resize(arcs);
+    res_.resize(arcs);
     reverse_.resize(arcs);
     fill_.assign(start_.begin(), start_.end() - 1);
     for (const Edge& e : added_) {
       const int forward = fill_[e.from]++, backward = fill_[e.to]++;
-      to_[forward] = e.to;
+      arc_[forward] = {e.from, e.to};
       cap_[forward] = e.cap;
       reverse_[forward] = backward;
-      to_[backward] = e.from;
+      arc_[backward] = {e.to, e.from};
       cap_[backward] = 0;
       reverse_[backward] = forward;
     }
   }
 
-  // Breadth-first levels from the source; nodes no nearer than the sink are not expanded.
-  bool levels(int source, int sink) {
-    level_.assign(nodes_, -1);
-    level_[source] = 0;
+  void reach(int source) {
+    reached_.assign(nodes_, 0);
+    reached_[source] = 1;
     queue_.assign(1, source);
     for (std::size_t q = 0; q < queue_.size(); ++q) {
       const int a = queue_[q];
-      if (level_[sink] >= 0 && level_[a] >= level_[sink]) break;
       for (int e = start_[a]; e < start_[a + 1]; ++e)
-        if (cap_[e] > 0 && level_[to_[e]] < 0) {
-          level_[to_[e]] = level_[a] + 1;
-          queue_.push_back(to_[e]);
+        if (res_[e] > 0 && !reached_[arc_[e].second]) {
+          reached_[arc_[e].second] = 1;
+          queue_.push_back(arc_[e].second);
         }
     }
-    return level_[sink] >= 0;
-  }
-
-  // One augmenting path along increasing levels (edge_[a]: the next arc of a to try).
-  bool augment(int source, int sink) {
-    path_.clear();
-    int a = source;
-    while (a != sink) {
-      int& e = edge_[a];
-      while (e < start_[a + 1] && (cap_[e] <= 0 || level_[to_[e]] != level_[a] + 1)) ++e;
-      if (e < start_[a + 1]) {
-        path_.push_back(e);
-        a = to_[e];
-      } else {
-        if (a == source) return false;
-        level_[a] = -2;  // a dead end for the rest of this phase
-        path_.pop_back();
-        a = path_.empty() ? source : to_[path_.back()];
-        ++edge_[a];
-      }
-    }
-    int f = kInfinite;
-    for (int e : path_) f = std::min(f, cap_[e]);
-    for (int e : path_) {
-      cap_[e] -= f;
-      cap_[reverse_[e]] += f;
-    }
-    return true;
   }
 
   int nodes_ = 0;
   std::vector<Edge> added_;
-  std::vector<int> start_, fill_, to_, cap_, reverse_, level_, edge_, queue_, path_;
+  std::vector<std::pair<int, int>> arc_;
+  std::vector<int> start_, fill_, cap_, res_, reverse_, queue_;
+  std::vector<char> reached_;
+  std::vector<boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
+                                                 boost::no_property, int, int>::edge_descriptor>
+      reverse_arc_, predecessor_;
+  std::vector<boost::default_color_type> colour_;
+  std::vector<int> distance_;
 };
 
 class Dissection {
@@ -195,9 +192,15 @@ class Dissection {
   int max_depth = -1;
 
  private:
+  // order_[begin, end) partitioned about its nth smallest coordinate along 'axis'. The selection
+  // runs on (coordinate, unknown) pairs copied in order_'s order: the same comparisons as on
+  // order_ itself, so the same permutation, without a scattered read of point_ per comparison.
   void select(int begin, int nth, int end, int axis) {
-    std::nth_element(order_.begin() + begin, order_.begin() + nth, order_.begin() + end,
-                     [&](int a, int b) { return point_[a][axis] < point_[b][axis]; });
+    keyed_.resize(end - begin);
+    for (int k = begin; k < end; ++k) keyed_[k - begin] = {point_[order_[k]][axis], order_[k]};
+    std::nth_element(keyed_.begin(), keyed_.begin() + (nth - begin), keyed_.end(),
+                     [](const Keyed& a, const Keyed& b) { return a.key < b.key; });
+    for (int k = begin; k < end; ++k) order_[k] = keyed_[k - begin].unknown;
   }
 
   // The axis whose median plane cuts the fewest edges of the part (the smallest cross-section).
@@ -284,6 +287,11 @@ class Dissection {
   const int leaf_size_;
   const double band_layers_;
   MaxFlow flow_;
+  struct Keyed {
+    double key;
+    int unknown;
+  };
+  std::vector<Keyed> keyed_;
   std::vector<int> order_, part_, slot_, band_;
   std::vector<char> side_;
   int parts_ = 0;

@@ -3,7 +3,8 @@
 // MPI_COMM_WORLD, each owning a contiguous block of rows:
 //
 //     mpirun -np P build/pfv_amg_solve FOLDER [--tolerance=1e-10] [--out=FILE] [--repeat=0]
-//         [--strong=0.5] [--coarsen=10] [--interp=6] [--pmax=4] [--relax=8] [--aggressive=0] [--print=0]
+//         [--strong=0.5] [--coarsen=10] [--interp=6] [--pmax=4] [--relax=8] [--relax-down=R] [--relax-up=R]
+//         [--aggressive=0] [--print=0]
 //
 // The solve starts from zero and stops by the engine's rule (estimated error below tolerance
 // times the spread of the pressures). Prints the processes, unknowns, levels, iterations, the
@@ -62,6 +63,10 @@ int run(int argc, char** argv) {
       parameters.max_row_entries = std::stoi(value);
     else if (arg.rfind("--relax=", 0) == 0)
       parameters.relax_type = std::stoi(value);
+    else if (arg.rfind("--relax-down=", 0) == 0)
+      parameters.relax_down = std::stoi(value);
+    else if (arg.rfind("--relax-up=", 0) == 0)
+      parameters.relax_up = std::stoi(value);
     else if (arg.rfind("--aggressive=", 0) == 0)
       parameters.aggressive_levels = std::stoi(value);
     else if (arg.rfind("--print=", 0) == 0)

@@ -194,6 +194,8 @@ AmgPcg::AmgPcg(MPI_Comm comm, const DistributedRows& rows, const AmgParameters& 
   HYPRE_BoomerAMGSetPMaxElmts(amg, parameters.max_row_entries);
   HYPRE_BoomerAMGSetRelaxType(amg, parameters.relax_type);
   HYPRE_BoomerAMGSetNumSweeps(amg, 1);
+  if (parameters.relax_down >= 0) HYPRE_BoomerAMGSetCycleRelaxType(amg, parameters.relax_down, 1);
+  if (parameters.relax_up >= 0) HYPRE_BoomerAMGSetCycleRelaxType(amg, parameters.relax_up, 2);
   HYPRE_BoomerAMGSetAggNumLevels(amg, parameters.aggressive_levels);
   check(HYPRE_BoomerAMGSetup(amg, m.a, m.b.par, m.x.par), "BoomerAMGSetup");
 

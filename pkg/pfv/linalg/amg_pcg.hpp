@@ -46,7 +46,11 @@ struct AmgParameters {
   int coarsen_type = 10;  // HMIS
   int interp_type = 6;    // extended+i
   int max_row_entries = 4;
-  int relax_type = 8;         // l1-scaled hybrid symmetric Gauss-Seidel
+  int relax_type = 8;  // l1-scaled hybrid symmetric Gauss-Seidel, where relax_down, relax_up are -1
+  // The smoothers on the way down and up the V-cycle: l1-scaled hybrid Gauss-Seidel forwards
+  // down, backwards up. The cycle stays symmetric, as CG needs, with one sweep per level and
+  // direction where the symmetric smoother makes two (bench/amg/amg_solve.cpp, doc/solvers.md).
+  int relax_down = -1, relax_up = -1;
   int aggressive_levels = 0;  // levels of aggressive coarsening (less memory, more iterations)
   int print_level = 0;        // hypre's report of the hierarchy (1: at set-up, on stdout)
 };

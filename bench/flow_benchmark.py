@@ -4,7 +4,8 @@ Run with YADE (the driver re-invokes yade-double on this file for every measurem
 
     yade-double -n -x bench/flow_benchmark.py [--quick] [--sizes=1000,10000,50000] [--rounds=3]
                 [--threads=1,2] [--out=doc/benchmarks.md] [--json=FILE] [--no-memory] [--no-oedometer]
-                [--no-multithread] [--no-double] [--oedo-sizes=1000,10000] [--oedo-steps=600] [--oedo-interval=200] [--steady=20]
+                [--no-multithread] [--no-double] [--oedo-sizes=1000,10000] [--oedo-steps=600] [--oedo-interval=200]
+                [--steady=20]
                 [--gen-threads=T]    (threads of the child that generates a missing packing; default max of --threads)
     yade-double -n -x bench/flow_benchmark.py --startup [--sizes=10000,50000] [--rounds=3] [--threads=1]
                 [--steady=5] [--out=doc/benchmarks.md]
@@ -283,7 +284,8 @@ def build_scene(n, oedometer=False, settle=True):
     spheres, meta = read_packing(n)
     L = meta.get('box', box_side(n))
     O.reset()
-    O.materials.append(FrictMat(young=YOUNG, poisson=0.5, frictionAngle=math.radians(30), density=2600, label='spheres'))
+    O.materials.append(FrictMat(young=YOUNG, poisson=0.5, frictionAngle=math.radians(30), density=2600,
+                                label='spheres'))
     O.materials.append(FrictMat(young=YOUNG, poisson=0.5, frictionAngle=0, density=0, label='walls'))
     walls = O.bodies.append(utils.aabbWalls([(0, 0, 0), (L, L, L)], thickness=0, material='walls'))
     assert walls == list(range(6)), walls
@@ -493,7 +495,8 @@ def run_trial(kind, info, steady, warnings_seen):
         res['reduced'] = bool(flow.core.reduced_precision_factor())
         res['guard'] = [dict(h) for h in flow.collective_viscous_history]
         res['factor_nonzeros'] = flow.core.factor_nonzeros()
-    del flow, proxy
+    # Release the engine before O.reset(); assigned, not deleted, because step() closes over both names.
+    flow = proxy = None
     O.engines = O.engines[:1]
     O.reset()
     gc.collect()
@@ -837,8 +840,10 @@ def machine_description():
     except Exception as e:
         d['pfv module'] = 'IMPORT FAILED: %s' % e
     d['git'] = (sh('git -C %s rev-parse --short HEAD' % REPO) +
-                (' (working tree modified in lib/ pkg/)' if sh('git -C %s status --porcelain lib pkg CMakeLists.txt' % REPO) else ''))
-    d['BLAS'] = os.path.realpath('/usr/lib/x86_64-linux-gnu/libblas.so.3') + ' (children run with OPENBLAS_NUM_THREADS = OMP_NUM_THREADS = yade -jN)'
+                (' (working tree modified in lib/ pkg/)'
+                 if sh('git -C %s status --porcelain lib pkg CMakeLists.txt' % REPO) else ''))
+    d['BLAS'] = (os.path.realpath('/usr/lib/x86_64-linux-gnu/libblas.so.3') +
+                 ' (children run with OPENBLAS_NUM_THREADS = OMP_NUM_THREADS = yade -jN)')
     d['load average at start'] = ' '.join('%.2f' % x for x in os.getloadavg())
     return d
 
@@ -916,7 +921,8 @@ def summarise(timing, memory):
                 d = {s: rt[s] for s in rem_stages}
                 d.update({'first ' + s: stt[s] for s in step_stages})
                 cpp = sum(d.values())
-                d['python + exchange'] = x['remesh']['exec'][k] - (x['remesh']['core_step'][k] if x['core_timer'] else cpp)
+                d['python + exchange'] = (x['remesh']['exec'][k] -
+                                          (x['remesh']['core_step'][k] if x['core_timer'] else cpp))
                 if x['core_timer']:
                     d['C++ untimed'] = x['remesh']['core_step'][k] - cpp
                 d['total (engine exec)'] = x['remesh']['exec'][k]
@@ -1033,8 +1039,8 @@ def report(opts, machine, packings, summ, mem, command):
     w('Scene: permeameter along y (dp = %g Pa, viscosity %g, p = 0 at ymax), six fixed walls (boundaries at the walls),'
       ' dynamic spheres with friction 30 deg, Newton damping 0.2, no gravity, O.dt = 0.5 P-wave step; the packing is '
       'at equilibrium under 10 kPa, so the drag (1 %% of the confinement) hardly moves it.  Both engines: CHOLMOD '
-      '(useSolver=3), slipBoundary=False, no automatic remesh (meshUpdateInterval=1e9, defTolerance=0); other attributes at their '
-      'defaults (YADE: multithread=False).' % (DP, VISCOSITY))
+      '(useSolver=3), slipBoundary=False, no automatic remesh (meshUpdateInterval=1e9, defTolerance=0); '
+      'other attributes at their defaults (YADE: multithread=False).' % (DP, VISCOSITY))
     w('')
     for t in sorted(summ, key=int):
         sizes = summ[t]['sizes']
@@ -1065,8 +1071,8 @@ def report(opts, machine, packings, summ, mem, command):
                 r = sizes[ns]
                 y, p, d = r['yade'], r['pfv'], r['pfv-double']
                 w('| %s | %s | %s | %s | %s | %s | %s | %s | %.2f | %.1e |'
-                  % (ns, r.get('default_factor', '?'), fmt_t(d['remesh']), fmt_r(d['remesh'], y['remesh']), fmt_t(d['flow']),
-                     fmt_r(d['flow'], y['flow']), fmt_t(d['coupled']),
+                  % (ns, r.get('default_factor', '?'), fmt_t(d['remesh']), fmt_r(d['remesh'], y['remesh']),
+                     fmt_t(d['flow']), fmt_r(d['flow'], y['flow']), fmt_t(d['coupled']),
                      fmt_r(d['coupled_minus_dry'], y['coupled_minus_dry']), p['flow'] / d['flow'],
                      r.get('double_agreement', {}).get('max_dp', float('nan'))))
             w('')
@@ -1092,25 +1098,27 @@ def report(opts, machine, packings, summ, mem, command):
               % (' '.join('%.2f' % v for v in ld[0]), ' '.join('%.2f' % v for v in ld[1]),
                  '' if t == '1' else ', up to %s with %s threads' % (t, t),
                  '; '.join('N=%s YADE %.2f PFV %.2f' % (ns, sizes[ns]['yade'].get('cpu_share') or float('nan'),
-                                                       sizes[ns]['pfv'].get('cpu_share') or float('nan'))
+                                                        sizes[ns]['pfv'].get('cpu_share') or float('nan'))
                            for ns in sorted(sizes, key=int))))
             w('')
         w('Scene before the trials (settled with damping 0.5): ' + '; '.join(
             'N=%s: %s steps, unbalanced force %.3g, dt %.3g s' % (ns, sizes[ns]['info'].get('settle_steps'),
-                                                            sizes[ns]['info'].get('unbalanced', float('nan')),
-                                                            sizes[ns]['info']['dt']) for ns in sorted(sizes, key=int)) + '.')
+                                                                  sizes[ns]['info'].get('unbalanced', float('nan')),
+                                                                  sizes[ns]['info']['dt'])
+            for ns in sorted(sizes, key=int)) + '.')
         w('')
     if mem:
         w('### Peak memory (fresh `yade-double -j1` per engine; growth over the scene without engine)')
         w('')
-        w('| N | scene RSS | dry peak growth | YADE peak growth | PFV peak growth | P/Y (net of dry) | YADE retained | PFV retained '
-          '| YADE peak first mesh / forced remesh | PFV peak first mesh / forced remesh |')
+        w('| N | scene RSS | dry peak growth | YADE peak growth | PFV peak growth | P/Y (net of dry) | YADE retained '
+          '| PFV retained | YADE peak first mesh / forced remesh | PFV peak first mesh / forced remesh |')
         w('|---|---|---|---|---|---|---|---|---|---|')
         for ns in sorted(mem, key=int):
             m = mem[ns]
             g = {k: m[k]['peak_kb'] - m[k]['rss_before_kb'] for k in m}
             ret = {k: m[k]['rss_after_kb'] - m[k]['rss_before_kb'] for k in m}
             d = g.get('dry', 0)
+
             def split(k):
                 x = m.get(k, {})
                 if 'peak_first_kb' not in x:
@@ -1118,15 +1126,16 @@ def report(opts, machine, packings, summ, mem, command):
                 return '%s / %s' % (fmt_mb(x['peak_first_kb'] - x['rss_before_kb']),
                                     fmt_mb(x['peak_remesh_kb'] - x['rss_before_kb']))
             w('| %s | %s | %s | %s | %s | **%s** | %s | %s | %s | %s |'
-              % (ns, fmt_mb(m.get('dry', m.get('yade'))['rss_before_kb']), fmt_mb(g.get('dry')), fmt_mb(g.get('yade')),
-                 fmt_mb(g.get('pfv')), fmt_r(g.get('pfv', 0) - d, g.get('yade', 0) - d), fmt_mb(ret.get('yade')),
-                 fmt_mb(ret.get('pfv')), split('yade'), split('pfv')))
+              % (ns, fmt_mb(m.get('dry', m.get('yade'))['rss_before_kb']), fmt_mb(g.get('dry')),
+                 fmt_mb(g.get('yade')), fmt_mb(g.get('pfv')), fmt_r(g.get('pfv', 0) - d, g.get('yade', 0) - d),
+                 fmt_mb(ret.get('yade')), fmt_mb(ret.get('pfv')), split('yade'), split('pfv')))
         exact = all(m[k]['peak_reset'] for m in mem.values() for k in m)
         w('')
         w('Peak = VmHWM %s minus VmRSS before the engine was added (the larger of the first-mesh phase: first step + '
           'steady steps, and of the forced-remesh phase, the high-water mark being reset in between); retained = VmRSS '
           'at the end minus before.'
-          % ('after a reset through /proc/self/clear_refs' if exact else '(could NOT be reset: includes scene building)'))
+          % ('after a reset through /proc/self/clear_refs' if exact
+             else '(could NOT be reset: includes scene building)'))
         w('')
     w('### Pressure agreement (PFV vs YADE, same scene, same step)')
     w('')
@@ -1161,8 +1170,9 @@ def report(opts, machine, packings, summ, mem, command):
         for k in keys:
             last = sizes[ns_list[-1]]['pfv_breakdown']['remesh']
             tot = last.get('total (engine exec)')
-            w('| %s | %s | %s |' % (k, ' | '.join(fmt_t(sizes[ns]['pfv_breakdown']['remesh'].get(k)) for ns in ns_list),
-                                    '%.0f %%' % (100 * last.get(k, 0) / tot) if tot and k != 'total (engine exec)' else ''))
+            w('| %s | %s | %s |'
+              % (k, ' | '.join(fmt_t(sizes[ns]['pfv_breakdown']['remesh'].get(k)) for ns in ns_list),
+                 '%.0f %%' % (100 * last.get(k, 0) / tot) if tot and k != 'total (engine exec)' else ''))
         w('')
         w('Steady step:')
         w('')
@@ -1176,8 +1186,9 @@ def report(opts, machine, packings, summ, mem, command):
         for k in keys:
             last = sizes[ns_list[-1]]['pfv_breakdown']['steady']
             tot = last.get('total (engine exec)')
-            w('| %s | %s | %s |' % (k, ' | '.join(fmt_t(sizes[ns]['pfv_breakdown']['steady'].get(k)) for ns in ns_list),
-                                    '%.0f %%' % (100 * last.get(k, 0) / tot) if tot and k != 'total (engine exec)' else ''))
+            w('| %s | %s | %s |'
+              % (k, ' | '.join(fmt_t(sizes[ns]['pfv_breakdown']['steady'].get(k)) for ns in ns_list),
+                 '%.0f %%' % (100 * last.get(k, 0) / tot) if tot and k != 'total (engine exec)' else ''))
         w('')
         w('Reference, on the dry scene: reading all positions with 3x `coordsAndDisplacements` + numpy: %s; '
           '`O.forces.addF(id, tuple)` for every sphere: %s.'
@@ -1188,15 +1199,17 @@ def report(opts, machine, packings, summ, mem, command):
         w('')
         keys = []
         for ns in ns_list:
-            for k in list(sizes[ns]['yade_breakdown'].get('remesh', {})) + list(sizes[ns]['yade_breakdown'].get('steady', {})):
+            for k in (list(sizes[ns]['yade_breakdown'].get('remesh', {})) +
+                      list(sizes[ns]['yade_breakdown'].get('steady', {}))):
                 if k not in keys:
                     keys.append(k)
         w('| YADE checkpoint | ' + ' | '.join('remesh N=%s' % ns for ns in ns_list) + ' | ' +
           ' | '.join('steady N=%s' % ns for ns in ns_list) + ' |')
         w('|---|' + '---|' * (2 * len(ns_list)))
         for k in keys:
-            w('| %s | %s | %s |' % (k, ' | '.join(fmt_t(sizes[ns]['yade_breakdown'].get('remesh', {}).get(k)) for ns in ns_list),
-                                    ' | '.join(fmt_t(sizes[ns]['yade_breakdown'].get('steady', {}).get(k)) for ns in ns_list)))
+            w('| %s | %s | %s |'
+              % (k, ' | '.join(fmt_t(sizes[ns]['yade_breakdown'].get('remesh', {}).get(k)) for ns in ns_list),
+                 ' | '.join(fmt_t(sizes[ns]['yade_breakdown'].get('steady', {}).get(k)) for ns in ns_list)))
         w('')
     # scaling
     t1 = sorted(summ, key=int)[0]
@@ -1238,11 +1251,12 @@ def report(opts, machine, packings, summ, mem, command):
     for kind, lab in (('yade', 'YADE'), ('pfv', 'PFV')):
         for what in ('remesh', 'flow'):
             vals = [sizes[ns][kind][what] for ns in ns_list]
-            w('| %s %s (total) | %s | %.2f |' % (lab, what, ' | '.join('%.3g' % (v / n * 1e6) for v, n in zip(vals, nvals)),
-                                                slope(nvals, vals)) + pad)
+            w('| %s %s (total) | %s | %.2f |'
+              % (lab, what, ' | '.join('%.3g' % (v / n * 1e6) for v, n in zip(vals, nvals)), slope(nvals, vals))
+              + pad)
     vals = [sizes[ns]['dry'] for ns in ns_list]
     w('| dry DEM step | %s | %.2f |' % (' | '.join('%.3g' % (v / n * 1e6) for v, n in zip(vals, nvals)),
-                                       slope(nvals, vals)) + pad)
+                                        slope(nvals, vals)) + pad)
     w('')
     w('Thesis fit formulas: ' + '; '.join('%s: %s' % (k, v[0]) for k, v in fits.items()) + '.')
     w('')
@@ -1254,8 +1268,8 @@ def report(opts, machine, packings, summ, mem, command):
           'Newton damping 0, O.dt = %g, meshUpdateInterval (below) and defTolerance 0.3 as in YADE\'s oedometer '
           'example; wall-clock time of O.run(M) per step, remeshing included.' % (OEDO_VISCOSITY, OEDO_DT))
         w('')
-        w('| threads | N | M steps | remesh interval | dry | YADE coupled | YADE coupled/dry | PFV coupled | PFV coupled/dry '
-          '| PFV remeshes | p(0.1 H) YADE / PFV | settlement dry / YADE / PFV |')
+        w('| threads | N | M steps | remesh interval | dry | YADE coupled | YADE coupled/dry | PFV coupled '
+          '| PFV coupled/dry | PFV remeshes | p(0.1 H) YADE / PFV | settlement dry / YADE / PFV |')
         w('|---|---|---|---|---|---|---|---|---|---|---|---|')
         for t in sorted(summ, key=int):
             for ns, r in sorted(summ[t]['oedometer'].items(), key=lambda kv: int(kv[0])):
@@ -1271,8 +1285,8 @@ def report(opts, machine, packings, summ, mem, command):
               'use a mesh built from slightly older positions; the accuracy cost is measured as the change of the '
               'pressure probe and of the settlement against the same engine without it):')
             w('')
-            w('| threads | N | YADE mt coupled | YADE mt coupled/dry | PFV mt coupled | PFV mt coupled/dry | mt/foreground YADE '
-              '| mt/foreground PFV | p(0.1 H) change YADE / PFV | settlement change YADE / PFV |')
+            w('| threads | N | YADE mt coupled | YADE mt coupled/dry | PFV mt coupled | PFV mt coupled/dry '
+              '| mt/foreground YADE | mt/foreground PFV | p(0.1 H) change YADE / PFV | settlement change YADE / PFV |')
             w('|---|---|---|---|---|---|---|---|---|---|')
 
             def change(r, kind, key):
@@ -1317,14 +1331,14 @@ def write_report(path, text, begin=BEGIN_MARK, end=END_MARK):
         else:
             new = old.rstrip('\n') + '\n\n' + block
     else:
-        new = ('# Benchmarks: PFV vs YADE\'s FlowEngine\n\nGenerated by `bench/flow_benchmark.py` (see its docstring for '
-               'the protocol). Text outside the markers is kept when the script is re-run.\n\n' + block)
+        new = ('# Benchmarks: PFV vs YADE\'s FlowEngine\n\nGenerated by `bench/flow_benchmark.py` '
+               '(see its docstring for the protocol). Text outside the markers is kept when the script is re-run.\n\n'
+               + block)
     with open(path, 'w') as f:
         f.write(new)
 
 
 def driver(opts, argv):
-    from yade import O
     started = datetime.datetime.now().strftime('%Y-%m-%d %H:%M')
     command = 'yade-double -n -x bench/flow_benchmark.py' + ('' if not argv else ' ' + ' '.join(argv))
     machine = machine_description()

@@ -1,4 +1,5 @@
-"""Stage measurements behind doc/benchmarks.md (stage measurements) and doc/solvers.md, on the cached benchmark packing (made by bench/flow_benchmark.py).
+"""Stage measurements behind doc/benchmarks.md (stage measurements) and doc/solvers.md, on the cached benchmark
+packing (made by bench/flow_benchmark.py).
 
     yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6,7]
 
@@ -164,7 +165,8 @@ def exchange(pos, rad, L):
         pfv._core.gather_sphere_pack(pack, index, centres)
         packed.append(time.perf_counter() - t0)
     print('   three lists alive together: %s; one axis at a time: %s' % (stats(together), stats(apart)))
-    print('   SpherePack.fromSimulation(): %s; with the in-place read of its centres: %s' % (stats(fill), stats(packed)))
+    print('   SpherePack.fromSimulation(): %s; with the in-place read of its centres: %s'
+          % (stats(fill), stats(packed)))
 
 
 def remesh_sequence(n):
@@ -209,7 +211,8 @@ def collective_limit(pos, rad, walls):
         power.append(limit)
     t_power = (time.perf_counter() - t0) / 3  # per 40 iterations
     print('   Arnoldi %.7g s in %.3f s; power iteration: %.7g after 39 iterations (%.3f s), %.7g after 120; '
-          'power-39 / Arnoldi - 1 = %.2g' % (arnoldi, t_arnoldi, power[12], t_power, power[-1], power[12] / arnoldi - 1))
+          'power-39 / Arnoldi - 1 = %.2g'
+          % (arnoldi, t_arnoldi, power[12], t_power, power[-1], power[12] / arnoldi - 1))
 
 
 def ordering_threshold(pos, rad, L, repeats=3):

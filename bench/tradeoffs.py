@@ -31,9 +31,10 @@ Options (each an engine, all stepped in lockstep on the same positions)
                  Cholesky preconditioned CG (useSolver 1, warm-started, tolerance = relative residual) at
                  tolerances 1e-3 ... 1e-9, on the remesh schedule mesh_update_interval = SOLVER_INTERVAL
   mixed          CHOLMOD with mixed_precision on (the factor in 32 bits, each solve refined in double from
-                 the previous pressures until the estimated error < refinement_tolerance * the pressure spread): at the default
-                 refinement_tolerance 1e-10 and at 1e-6; in the oedometers on the interval-10 and defTolerance-0.01
-                 schedules, and compared also with the double CHOLMOD on the same schedule ("same mesh")
+                 the previous pressures until the estimated error < refinement_tolerance * the pressure spread):
+                 at the default refinement_tolerance 1e-10 and at 1e-6; in the oedometers on the interval-10 and
+                 defTolerance-0.01 schedules, and compared also with the double CHOLMOD on the same schedule
+                 ("same mesh")
   multigrid      CG preconditioned by one BoomerAMG V-cycle (solver 'multigrid', warm-started, stopped when the
                  estimated error < refinement_tolerance * the pressure spread): 1e-4 ... 1e-10 on the permeameter,
                  1e-6 and 1e-10 in the oedometers on the solver sweeps' schedule
@@ -262,7 +263,8 @@ def run_perm(pfv, n, work, rounds, quick):
                 rec['iters_first'] = errs[0]['iters']
                 rec['iters_steady'] = float(np.mean([er['iters'] for er in errs[1:]]))
                 rec['n_cells'] = e.n_cells()
-            log(f'perm n={n} round {rnd} {c["name"]}: first {times[0]*1e3:.1f} ms, step {np.median(times[1:])*1e3:.2f} ms')
+            log(f'perm n={n} round {rnd} {c["name"]}: first {times[0]*1e3:.1f} ms, '
+                f'step {np.median(times[1:])*1e3:.2f} ms')
             del e
     for rec in res.values():
         rec['first_median'] = float(np.median(rec['first']))
@@ -346,10 +348,12 @@ def run_oedo(pfv, scene, n, work, quick):
                    conservation=float(cons[j, 0] / cons[j, 1]),
                    n_cells=engines[j].n_cells())
         out.append(rec)
+
     # Pure solver error: each solver run against the double CHOLMOD on the same remesh schedule.
     def schedule(c):
         return (c['interval'], c.get('def_tol', 0.0))
-    by_schedule = {schedule(c): j for j, c in enumerate(cfgs) if c['family'] in ('interval', 'defTolerance', 'reference')}
+    by_schedule = {schedule(c): j for j, c in enumerate(cfgs)
+                   if c['family'] in ('interval', 'defTolerance', 'reference')}
     for j, c in enumerate(cfgs):
         if c['family'] in ('GS', 'PCG', 'AMG-PCG', 'mixed') and schedule(c) in by_schedule:
             b = by_schedule[schedule(c)]
@@ -382,11 +386,13 @@ def fmt(x, digits=2):
 def report(parts, command, quick):
     L = []
     perm = sorted([p for p in parts if p['scene'] == 'perm'], key=lambda p: p['n'])
-    L.append(f'Produced by `{command}`' + (' (quick mode: smaller sizes, fewer steps; not for decisions)' if quick else '') + '.')
+    L.append(f'Produced by `{command}`'
+             + (' (quick mode: smaller sizes, fewer steps; not for decisions)' if quick else '') + '.')
     L.append('')
     L.append('Packings: ' + '; '.join(
         f"N = {p['n']}: side {p['packing']['side']:.3g}, porosity {p['packing']['porosity']:.3f}, "
-        f"largest overlap {100 * p['packing']['max_overlap_over_r']:.1f} % of the smaller radius, {p['configs'][0]['n_cells']} cells"
+        f"largest overlap {100 * p['packing']['max_overlap_over_r']:.1f} % of the smaller radius, "
+        f"{p['configs'][0]['n_cells']} cells"
         for p in perm) + '.')
     L.append('')
     for p in perm:
@@ -398,8 +404,9 @@ def report(parts, command, quick):
         for c in p['configs']:
             ef, es = c['err_first'], c['err_steady']
             L.append(f"| {c['name']} | {c['first_median'] * 1e3:.1f} | {c['iters_first']} | {fmt(ef['g_error'])} | "
-                     f"{fmt(ef['q_error'])} | {fmt(ef['p_error'])} | {fmt(ef['f_error'])} | {c['step_median'] * 1e3:.2f} | "
-                     f"{c['iters_steady']:.0f} | {fmt(es['g_error'])} | {fmt(es['p_error'])} |")
+                     f"{fmt(ef['q_error'])} | {fmt(ef['p_error'])} | {fmt(ef['f_error'])} | "
+                     f"{c['step_median'] * 1e3:.2f} | {c['iters_steady']:.0f} | {fmt(es['g_error'])} | "
+                     f"{fmt(es['p_error'])} |")
         L.append('')
         pts = [(c['step_median'], max(c['err_steady']['p_error'], 1e-12)) for c in p['configs']]
         L.append('Pareto front (steady-step cost, max pressure error): ' + ' → '.join(
@@ -418,8 +425,8 @@ def report(parts, command, quick):
             for c in p['configs']:
                 extra = f" (same mesh: {fmt(c['e_base_same_mesh'])})" if 'e_base_same_mesh' in c else ''
                 L.append(f"| {c['name']} | {c['remeshes']} | {c['cost'] * 1e3:.2f} | {c['remesh_cpu'] * 1e3:.2f} | "
-                         f"{c['iters_mean']:.0f} | {fmt(c['e_base'])}{extra} | {fmt(c['e_base_max'])} | {fmt(c['e_mid'])} | "
-                         f"{fmt(c['e_force'])} | {fmt(c['conservation'])} |")
+                         f"{c['iters_mean']:.0f} | {fmt(c['e_base'])}{extra} | {fmt(c['e_base_max'])} | "
+                         f"{fmt(c['e_mid'])} | {fmt(c['e_force'])} | {fmt(c['conservation'])} |")
             L.append('')
             pts = [(c['cost'], max(c['e_base'], 1e-12)) for c in p['configs']]
             front = pareto(pts)
@@ -452,7 +459,8 @@ def figure(parts, path):
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    panels = [('perm', 'first', 'permeameter, first solve (mesh + set-up + cold solve)', 'G_error = |Qin + Qout| / |Qin|'),
+    panels = [('perm', 'first', 'permeameter, first solve (mesh + set-up + cold solve)',
+               'G_error = |Qin + Qout| / |Qin|'),
               ('perm', 'steady', 'permeameter, steady step (varying inlet pressure)', 'max pressure error / p_in'),
               ('slow', None, 'oedometer, slow consolidation', 'e_base (RMS / peak base pressure)'),
               ('fast', None, 'oedometer, fast deformation', 'e_base (RMS / peak base pressure)')]

@@ -1,7 +1,7 @@
 """Cost of the optional viscous shear term (viscousShear): remesh and step time with it off and on.
 
-    OMP_NUM_THREADS=1 PYTHONPATH=build/python /usr/bin/python3.11 bench/viscous_shear_cost.py [--n=20] [--rounds=3] [--steps=20]
-                                                                                       [--modes=off,on]
+    OMP_NUM_THREADS=1 PYTHONPATH=build/python /usr/bin/python3.11 bench/viscous_shear_cost.py
+        [--n=20] [--rounds=3] [--steps=20] [--modes=off,on]
 
 Scene: n^3 equal-size spheres (radius 0.4 a) on a jittered simple cubic lattice of spacing a (jitter 0.15 a, seeded:
 no cospherical groups) in the unit box, permeameter along y, every sphere moving with a small random velocity.

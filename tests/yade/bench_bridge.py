@@ -46,7 +46,9 @@ def bench_read():
         a = np.empty((n, 3))
         for i, b in enumerate(O.bodies):
             p = b.state.pos
-            a[i, 0] = p[0]; a[i, 1] = p[1]; a[i, 2] = p[2]
+            a[i, 0] = p[0]
+            a[i, 1] = p[1]
+            a[i, 2] = p[2]
         return a
 
     rows = [
@@ -75,7 +77,8 @@ def bench_write():
     addF = O.forces.addF
     rows = [
         ('addF(i, tuple), tuples made beforehand', lambda: [addF(i, f) for i, f in zip(ids, tuples)]),
-        ('O.forces.addF(i, tuple) (attribute lookup each call)', lambda: [O.forces.addF(i, f) for i, f in zip(ids, tuples)]),
+        ('O.forces.addF(i, tuple) (attribute lookup each call)',
+         lambda: [O.forces.addF(i, f) for i, f in zip(ids, tuples)]),
         ('addF(i, Vector3), Vector3 made beforehand', lambda: [addF(i, f) for i, f in zip(ids, vecs)]),
         ('addF(i, Vector3(x,y,z)) made each call', lambda: [addF(i, Vector3(*f)) for i, f in zip(ids, tuples)]),
         ('from numpy: map(addF, ids, map(tuple, F.tolist()))', lambda: list(map(addF, ids, map(tuple, F.tolist())))),

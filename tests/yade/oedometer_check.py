@@ -4,7 +4,6 @@ import math
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 
 EXAMPLE = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'examples',
@@ -19,7 +18,7 @@ def run_and_check(args, thresholds, extra_check=None):
     cmd = [yade, '-n', '-x', EXAMPLE] + list(args) + ['--out=' + out]
     print('running: ' + ' '.join(cmd), flush=True)
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    lines = [l for l in proc.stdout.splitlines() if l.startswith('oedometer:')]
+    lines = [line for line in proc.stdout.splitlines() if line.startswith('oedometer:')]
     print('\n'.join(lines))
     path = os.path.join(out, 'summary.json')
     if proc.returncode != 0 or not os.path.exists(path):

@@ -13,8 +13,13 @@
 # yade_wall_throat_factor=False: the thesis' slip-wall formula without YADE's multiplier).  GUI plotting calls are
 # made harmless.
 # Exit code: 0 if the script ran to the end, 1 on any exception (including YadeCheckError) or if pfv is missing.
-import sys, os, time, traceback
+import os
+import sys
+import time
+import traceback
+
 import yade
+from yade import O  # the same Omega as the `O` already in __main__'s namespace
 import __main__
 
 SHORTCUTS = {

@@ -9,8 +9,9 @@ Import from a script run by yade-double (the script adds this directory to sys.p
     scenes.configure_flow(flow, axis=1, dp=1.0)
 
 The 1000-sphere packing (seed 1, unit box) is shipped in tests/yade/data/ (made with yade-double -j1), so it is
-bit-identical on every machine.  Other packings are produced once by DEM compaction (makeCloud with a fixed seed, then particle growth under a
-TriaxialStressController until the mean stress is reached), written to a text cache with every float in repr()
+bit-identical on every machine.  Other packings are produced once by DEM compaction (makeCloud with a fixed seed,
+then particle growth under a TriaxialStressController until the mean stress is reached), written to a text cache
+with every float in repr()
 form, and every scene is built *from that file*, so two builds of the same scene are bit-identical (the first
 build included).  The cache lives in $PFV_SCENE_CACHE or /tmp/pfv-yade-scenes.  The compaction runs every
 engine with ompThreads=1; regenerating the cache gives the same packing for the same `yade -jN` (it does differ
@@ -93,7 +94,8 @@ def packing(num=1000, seed=1, box=(1.0, 1.0, 1.0), regenerate=False):
         os.makedirs(CACHE_DIR, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=CACHE_DIR, prefix='.tmp-')
         with os.fdopen(fd, 'w') as f:
-            f.write('# pfv permeameter packing: num=%d seed=%d box=%r; x y z r (repr floats)\n' % (num, seed, tuple(box)))
+            f.write('# pfv permeameter packing: num=%d seed=%d box=%r; x y z r (repr floats)\n'
+                    % (num, seed, tuple(box)))
             for s in spheres:
                 f.write(' '.join(repr(float(v)) for v in s) + '\n')
         os.chmod(tmp, 0o644)

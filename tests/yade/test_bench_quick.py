@@ -50,7 +50,7 @@ def main():
         cmd = [exe, '-n', '-x', BENCH, '--quick', '--out=' + out, '--json=' + js]
         print('running:', ' '.join(cmd), flush=True)
         r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-        print('\n'.join(l for l in r.stdout.splitlines() if l.startswith(('bench:', '  [')))[-4000:])
+        print('\n'.join(line for line in r.stdout.splitlines() if line.startswith(('bench:', '  [')))[-4000:])
         check(r.returncode == 0, 'benchmark exit code 0 (got %d)' % r.returncode)
         if r.returncode != 0:
             print(r.stdout[-4000:], r.stderr[-2000:])
@@ -58,15 +58,15 @@ def main():
         md = open(out).read() if os.path.exists(out) else ''
         check('flow_benchmark output' in md, 'report written between markers')
         lines = md.splitlines()
-        head = next((i for i, l in enumerate(lines) if 'remesh YADE' in l and 'remesh PFV' in l), None)
+        head = next((i for i, line in enumerate(lines) if 'remesh YADE' in line and 'remesh PFV' in line), None)
         check(head is not None, 'timing table has YADE and PFV columns')
         rows = []
         if head is not None:
-            for l in lines[head + 2:]:
-                if not l.startswith('|'):
+            for line in lines[head + 2:]:
+                if not line.startswith('|'):
                     break
-                rows.append(l)
-        rows = [l for l in rows if l.startswith('| %d |' % QUICK_SIZE)]
+                rows.append(line)
+        rows = [line for line in rows if line.startswith('| %d |' % QUICK_SIZE)]
         check(len(rows) >= 1, 'timing table has a row for N=%d' % QUICK_SIZE)
         if rows:
             cells = [c.strip() for c in rows[0].strip('|').split('|')]
@@ -88,7 +88,8 @@ def main():
             check(stage in br.get('steady', {}), 'PFV steady breakdown has %s' % stage)
         a = row.get('agreement', {})
         check(isinstance(a.get('max_dp'), float) and math.isfinite(a['max_dp']), 'pressure comparison computed')
-        print('  (info) probe pressures: max |dp|/dp = %s, Qin rel. diff = %s' % (a.get('max_dp'), a.get('flux_in_rel')))
+        print('  (info) probe pressures: max |dp|/dp = %s, Qin rel. diff = %s'
+              % (a.get('max_dp'), a.get('flux_in_rel')))
         mem = data.get('memory', {}).get(str(QUICK_SIZE), {})
         for kind in ('dry', 'yade', 'pfv'):
             m = mem.get(kind, {})

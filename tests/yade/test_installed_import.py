@@ -16,7 +16,7 @@ with tempfile.TemporaryDirectory() as d:
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     out = subprocess.run(["yade-double", "-n", "-x", path], cwd=d, env=env, capture_output=True, text=True)
     print(out.stdout[-500:], out.stderr[-500:])
-    location = [l for l in out.stdout.splitlines() if l.startswith("PFV_AT")]
+    location = [line for line in out.stdout.splitlines() if line.startswith("PFV_AT")]
     ok = out.returncode == 0 and location and "dist-packages/pfv" in location[0]
     print("installed pfv importable:", bool(ok))
     sys.exit(0 if ok else 1)

@@ -49,8 +49,9 @@ def main():
                               text=True, env=env, timeout=600)
         code, text = proc.returncode, proc.stdout
     except subprocess.TimeoutExpired as e:
-        code, text = 'timeout', (e.stdout or b'').decode(errors='replace') if isinstance(e.stdout, bytes) else (e.stdout or '')
-    print('\n'.join(l for l in text.splitlines() if l.startswith(('oedometer:', 'gui driver:'))))
+        code, text = 'timeout', ((e.stdout or b'').decode(errors='replace') if isinstance(e.stdout, bytes)
+                                 else (e.stdout or ''))
+    print('\n'.join(line for line in text.splitlines() if line.startswith(('oedometer:', 'gui driver:'))))
     check(code == 0, 'GUI run completed (exit %s)' % code)
     gui_json = os.path.join(out, 'gui', 'gui.json')
     summary_path = os.path.join(out, 'gui', 'run', 'summary.json')
@@ -64,7 +65,8 @@ def main():
           % (g['status'], g['hasDisplay']))
     running = [t for t in g['ticks'] if t['running']]
     seen = set(w.split(':')[0] for t in running for w in t['windows'])
-    check({'ControllerClass', 'QOpenGLWidget', 'MainWindow'} <= seen and max((t['views'] for t in running), default=0) >= 1,
+    check({'ControllerClass', 'QOpenGLWidget', 'MainWindow'} <= seen
+          and max((t['views'] for t in running), default=0) >= 1,
           "controller, 3D view and live figure on screen during the run (%s)" % sorted(seen))
     iters = [t['iter'] for t in running]
     points = [t['points'] for t in running]

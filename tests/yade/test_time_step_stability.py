@@ -146,7 +146,8 @@ rho_d2 = min(b.material.density * (2 * b.shape.radius) ** 2 for b in O.bodies
 dt_mv_formula = math.pi * rho_d2 / (1200 * MU)
 dt_mv = flow.viscous_time_step
 dt_dem = utils.PWaveTimeStep()
-check(abs(dt_mv / dt_mv_formula - 1) < 1e-9, "dt_MV = %.6g s = pi rho d^2 / (1200 mu) = %.6g s" % (dt_mv, dt_mv_formula))
+check(abs(dt_mv / dt_mv_formula - 1) < 1e-9,
+      "dt_MV = %.6g s = pi rho d^2 / (1200 mu) = %.6g s" % (dt_mv, dt_mv_formula))
 check(abs(flow.critical_time_step / min(dt_mv, dt_dem) - 1) < 1e-9,
       "critical_time_step %.6g s = min(dt_MV, P-wave %.6g s); dt_DEM / dt_MV = %.1f"
       % (flow.critical_time_step, dt_dem, dt_dem / dt_mv))
@@ -159,7 +160,7 @@ hist, seen, error = run_steps(60, ke0, stop_ratio=1e12)
 dt_warnings = [(i - it0, w) for i, w in seen if issubclass(w.category, TimeStepWarning)]
 grown = [k for k, r in enumerate(hist, 1) if r > 10]
 print("     1.5 dt_MV: KE/KE0 after steps 1..%d: %s%s" % (len(hist), " ".join("%.3g" % r for r in hist[:25]),
-                                                         (" ... run stopped: " + error) if error else ""))
+                                                          (" ... run stopped: " + error) if error else ""))
 check(len(dt_warnings) == 1, "one TimeStepWarning at 1.5 dt_MV (got %d)" % len(dt_warnings))
 if dt_warnings:
     step_w, w = dt_warnings[0]
@@ -194,6 +195,7 @@ except ValueError as e:
     direct = str(e)
 check(direct is not None, "strict_time_step: the engine's check raises ValueError")
 flow.strict_time_step = False
+
 
 # 4. a small enough step is stable (control: the scene and the criterion are sound) --------------------------------
 def stable_run(factor, label, flow=None):
@@ -230,7 +232,7 @@ ok, seen = stable_run(factor, "engine limit")
 check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
       "no TimeStepWarning at O.dt = time_step_safety * critical_time_step = %.3g dt_MV" % factor)
 
-# 6. the limit follows the compaction: recomputed at the remesh, warned there -------------------------------------------
+# 6. the limit follows the compaction: recomputed at the remesh, warned there ------------------------------------------
 flow = build()
 O.dt = 1e-3 * flow.viscous_time_step
 O.step()

@@ -68,7 +68,8 @@ pos_off = positions(ids_off)
 O.run(1, True)
 fluid_off = [flow_off.fluidForce(i) for i in ids_off]
 total_off = [Vector3(O.forces.f(i)) for i in ids_off]
-check(max((a - b).norm() for a, b in zip(pos_on, pos_off)) == 0.0, "identical positions after the first step (no velocity yet: no shear)")
+check(max((a - b).norm() for a, b in zip(pos_on, pos_off)) == 0.0,
+      "identical positions after the first step (no velocity yet: no shear)")
 scale = max(f.norm() for f in fluid_off)
 shear_scale = max(f.norm() for f in shear_on)
 print(f"     largest fluid force {scale:.4g} N, largest shear force {shear_scale:.4g} N (mu = 1 Pa.s)")

@@ -107,7 +107,7 @@ check(message is not None and "outside the pack" in message, f"index beyond the 
 message = raises(ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(3), np.empty((2, 3))))
 check(message is not None and "shape" in message, f"centres of the wrong shape: ValueError ({message})")
 message = raises(ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(2), np.empty((2, 3)),
-                                                                np.empty(2, dtype=np.float32)))
+                                                              np.empty(2, dtype=np.float32)))
 check(message is not None and "radii" in message, f"radii not float64: ValueError ({message})")
 
 # Forces: the bridge calls YADE's force_add (the function O.forces.addF is bound to) directly;
@@ -119,7 +119,8 @@ scenes.build_permeameter(num=1000, frozen=False)
 n_bodies = len(O.bodies)
 ids = np.array([b.id for b in O.bodies], dtype=np.int64)
 rows = np.arange(len(ids), dtype=np.int64)[::-1].copy()  # any row order
-F = np.random.default_rng(7).normal(size=(len(ids), 3)) * 10.0 ** np.random.default_rng(8).integers(-6, 6, len(ids))[:, None]
+F = (np.random.default_rng(7).normal(size=(len(ids), 3))
+     * 10.0 ** np.random.default_rng(8).integers(-6, 6, len(ids))[:, None])
 bridge = _core.YadeForceBridge(Vector3, ids, rows)
 check(bridge.calls_yade_directly, "the bridge found YADE's force_add")
 

@@ -47,7 +47,8 @@ def options(argv, defaults):
 
 def build(sample, settings=None):
     """The bed with its flow engine (FlowEngine attributes in `settings` set on top of this
-    example's); returns (flow, box)."""
+    example's); returns (flow, box, time_steps), the last the first step's O.dt and the limits it
+    was chosen from."""
     seabed_sample.load_into_scene(sample)
     L, h, W = sample["box"]
     flow = FlowEngine(label="flow", viscosity=VISCOSITY, fluid_density=RHO_F, meshUpdateInterval=200,
@@ -60,16 +61,21 @@ def build(sample, settings=None):
     engines.insert(engines.index(newton), flow)
     O.engines = engines
     # The collective viscous limit of the bed (below the single-grain dt_MV) is known once the engine
-    # has a mesh: one short step, then 0.6 of the engine's critical step (it warns above 0.8).
-    O.dt = 0.3 * min(utils.PWaveTimeStep(), flow.viscous_time_step)
+    # has a mesh: one short step, then 0.6 of the engine's critical step (it warns above 0.8). The
+    # short step stays below the guard's 0.8 x limit for collective limits down to 0.125 dt_MV; the
+    # dense 5000-grain bed has 0.31 dt_MV, the loose one 0.55.
+    first = 0.1 * min(utils.PWaveTimeStep(), flow.viscous_time_step)
+    O.dt = first
     O.run(1, True)
     O.dt = 0.6 * flow.critical_time_step
-    return flow, (L, h, W)
+    time_steps = dict(first_step=first, viscous=flow.viscous_time_step,
+                      collective_viscous=flow.collective_viscous_time_step, p_wave=utils.PWaveTimeStep())
+    return flow, (L, h, W), time_steps
 
 
 def run(load_name, load, sample, duration, out, period, settings=None):
     """Run the bed under `load` (a pfv.waves profile) for `duration` s and write the outputs."""
-    flow, (L, h, W) = build(sample, settings)
+    flow, (L, h, W), time_steps = build(sample, settings)
     flow.set_boundary_pressure(flow.ymax, load)
     n0 = sample["porosity"]
     grid = diagnostics.SensorGrid.in_box((0, 0, 0), (L, h, W), verticals=5, levels=6)
@@ -110,6 +116,7 @@ def run(load_name, load, sample, duration, out, period, settings=None):
     peak = float(np.max(smooth[after])) if np.any(after) else float("nan")
     summary = dict(load=load_name, profile=repr(load), grains=sample["num"], friction_prep=sample["friction"],
                    settings=settings or {}, porosity0=n0, i_c=monitor.i_c, duration=duration, dt=O.dt, steps=O.iter,
+                   time_steps=time_steps,
                    wall_seconds=wall,
                    peak_mean_ratio=peak, liquefied=bool(peak > LIQUEFIED),
                    final_porosity=plot.data["porosity"][-1], settlement=plot.data["top"][0] - plot.data["top"][-1],

@@ -118,7 +118,10 @@ TEST(MixedPrecision, ToleranceFollowsThePressureDifferencesNotTheirOffset) {
     for (std::size_t c = 0; c < exact.pressure().size(); ++c)
       floor = std::max(floor, std::abs(exact.pressure()[c] - (1e5 + offset_free.pressure()[c])));
     EXPECT_LT(floor, 1e-7 * spread) << "the double reference itself at 1e5 Pa";
-    const double bound = floor + 10 * mixed.settings.refinement_tolerance * spread;
+    // The mixed solve's residual is computed in double at 1e5 Pa too, so its own round-off is of
+    // the size of the double solve's (measured 0.5-1.3 x floor over the steps and builds), on top
+    // of the refinement's tolerance; an offset-relative tolerance would allow 1e-5 Pa instead.
+    const double bound = 2 * floor + 10 * mixed.settings.refinement_tolerance * spread;
     for (std::size_t c = 0; c < exact.pressure().size(); ++c)
       ASSERT_NEAR(mixed.pressure()[c], 1e5 + offset_free.pressure()[c], bound)
           << "step " << step << " cell " << c << ", double round-off " << floor;

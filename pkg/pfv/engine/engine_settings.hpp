@@ -44,8 +44,8 @@ struct EngineSettings {
   double mixed_precision_min_entries = 2e6;
   double refinement_tolerance = 1e-10;
   int max_refinement_passes = 8;
-  // Let CHOLMOD fork the OpenMP teams of its numeric factorisation (compiled in) instead of
-  // running them on the calling thread (serial_openmp.hpp); kept to measure the difference.
+  // Factorise with CHOLMOD's own numeric phase, forking the OpenMP teams compiled into it,
+  // instead of PFV's (supernodal_numeric.hpp); kept to measure the difference.
   bool cholmod_openmp_teams = false;
   int mesh_update_interval = 1000;
   double def_tolerance = 0;  // YADE's default: no strain-triggered remesh

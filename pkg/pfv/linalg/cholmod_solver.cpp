@@ -230,15 +230,33 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
   cholmod_common* c = &common_->c;
   auto* f = static_cast<cholmod_factor*>(factor_);
   const int n = s.n_unknowns();
-  cholmod_sparse a = view_of(s);
-  if (openmp_teams_) {
-    cholmod_factorize(&a, f, c);
+  std::size_t minor = static_cast<std::size_t>(n);
+  if (openmp_teams_ || !f->is_super || !f->x) {
+    cholmod_sparse a = view_of(s);
+    if (openmp_teams_) {
+      cholmod_factorize(&a, f, c);
+    } else {
+      const SerialOpenMpRegions serial;
+      cholmod_factorize(&a, f, c);
+    }
+    minor = c->status == CHOLMOD_NOT_POSDEF ? std::min<std::size_t>(f->minor, n - 1) : f->minor;
   } else {
-    const SerialOpenMpRegions serial;
-    cholmod_factorize(&a, f, c);
+    // PFV's numeric phase on CHOLMOD's symbolic factor (supernodal_numeric.hpp: why).
+    SupernodalSymbolic symbolic;
+    symbolic.n = n;
+    symbolic.nsuper = static_cast<int>(f->nsuper);
+    symbolic.super = static_cast<const int*>(f->super);
+    symbolic.pi = static_cast<const int*>(f->pi);
+    symbolic.px = static_cast<const int*>(f->px);
+    symbolic.rows = static_cast<const int*>(f->s);
+    symbolic.perm = static_cast<const int*>(f->Perm);
+    symbolic.max_update = static_cast<long>(f->maxcsize);
+    const int failed = supernodal_numeric(symbolic, s, static_cast<double*>(f->x), numeric_work_);
+    if (failed >= 0) minor = static_cast<std::size_t>(failed);
+    f->is_ll = 1;
+    f->minor = minor;
   }
-  if (c->status == CHOLMOD_NOT_POSDEF || f->minor < static_cast<size_t>(n)) {
-    const auto minor = f->minor;
+  if (minor < static_cast<std::size_t>(n)) {
     release();
     throw std::domain_error(
         "singular pressure system: the conductance matrix is not positive definite "

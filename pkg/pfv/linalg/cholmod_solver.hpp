@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pfv/linalg/parallel_substitution.hpp"
+#include "pfv/linalg/supernodal_numeric.hpp"
 
 namespace pfv {
 
@@ -136,6 +137,7 @@ class CholmodSolver {
   struct Common;
   Common* common_;
   bool openmp_teams_ = false;
+  SupernodalWorkspace numeric_work_;
   double max_entries_ = kNever;
   void* factor_ = nullptr;  // cholmod_factor*
   // The factor's numeric values, lent to CHOLMOD (which otherwise allocates them afresh at

@@ -64,10 +64,10 @@ class MaxFlow {
 
   void run(int source, int sink) {
     arrange();
-    using Graph = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
-                                                     boost::no_property, int, int>;
-    using EdgeRef = Graph::edge_descriptor;
-    const Graph g(boost::edges_are_sorted, arc_.begin(), arc_.end(), nodes_);
+    using BandGraph = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
+                                                         boost::no_property, int, int>;
+    using EdgeRef = BandGraph::edge_descriptor;
+    const BandGraph g(boost::edges_are_sorted, arc_.begin(), arc_.end(), nodes_);
     reverse_arc_.resize(arc_.size());
     for (std::size_t e = 0; e < arc_.size(); ++e) reverse_arc_[e] = EdgeRef(arc_[e].second, reverse_[e]);
     predecessor_.resize(nodes_);

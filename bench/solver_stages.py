@@ -13,10 +13,11 @@ packing (made by bench/flow_benchmark.py).
 4. positions read: coordsAndDisplacements for the three axes with the lists alive together, and one at a time,
    against SpherePack.fromSimulation() plus the engine's in-place read of the pack (gather_sphere_pack);
 5. successive forced remeshes of one pfv.FlowEngine on the settled permeameter scene of bench/flow_benchmark.py (the
-   benchmark's "remesh" is the second mesh of an engine): C++ stage times per remesh, and the factorisation with
-   CHOLMOD's own OpenMP teams (4 threads, its compiled-in CHOLMOD_OMP_NUM_THREADS) against the engine's default, which
-   runs them on the calling thread (`flow.core.cholmod_openmp_teams`), and the page faults of each remesh step
-   (getrusage: the factor's storage is reused from the second mesh on);
+   benchmark's "remesh" is the second mesh of an engine): C++ stage times per remesh, and CHOLMOD's numeric
+   factorisation with its own OpenMP teams (4 threads, its compiled-in CHOLMOD_OMP_NUM_THREADS;
+   `flow.core.cholmod_openmp_teams`) against the engine's default, PFV's numeric factorisation on CHOLMOD's
+   symbolic factor, and the page faults of each remesh step (getrusage: the factor's storage is reused from the
+   second mesh on);
 6. the collective viscous limit of a first mesh (drained top, viscosity 10, density 2600): the engine's Arnoldi
    (at most 40 operator applications) against power iteration from the same fixed start, 40 and 120 iterations;
 7. the first ordering against the size (the threshold kGeometricFrom of ordering="auto"): sub-cubes of the packing
@@ -185,8 +186,8 @@ def remesh_sequence(n):
         O.step()
         faults = resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults
         t = core.remesh_times()
-        print('   mesh %d, CHOLMOD OpenMP regions %s: %s; %d page faults' % (
-            core.remesh_count, 'on the calling thread' if serial else 'in CHOLMOD teams of 4',
+        print('   mesh %d, %s: %s; %d page faults' % (
+            core.remesh_count, "PFV's numeric factorisation" if serial else "CHOLMOD's, in its teams of 4",
             ', '.join('%s %.1f ms' % (k, 1e3 * t[k]) for k in keys), faults))
     O.engines = O.engines[:1]
 

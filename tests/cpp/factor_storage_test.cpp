@@ -11,14 +11,6 @@ using namespace pfv;
 
 namespace {
 
-// The assembled permeameter system of a random packing.
-PressureSystem system_of(int n, unsigned seed) {
-  const auto p = test::random_packing(n, seed, 0.02, 0.035);
-  FlowEngine e = test::permeameter(1);
-  e.step(p.centre, p.radius, p.walls, 1.0);
-  return e.system();
-}
-
 std::vector<double> rhs(int n) {
   std::vector<double> b(n);
   for (int i = 0; i < n; ++i) b[i] = std::sin(0.37 * i + 1);
@@ -34,7 +26,7 @@ std::vector<double> solve(CholmodSolver& s, const std::vector<double>& b) {
 }  // namespace
 
 TEST(FactorStorage, ReusedStorageGivesTheFreshSolution) {
-  const PressureSystem small = system_of(300, 3), large = system_of(700, 4);
+  const PressureSystem small = test::permeameter_system(300, 3), large = test::permeameter_system(700, 4);
   ASSERT_LT(small.n_unknowns(), large.n_unknowns());
   const auto b = rhs(small.n_unknowns());
 

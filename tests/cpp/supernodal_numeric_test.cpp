@@ -13,13 +13,6 @@ using namespace pfv;
 
 namespace {
 
-PressureSystem system_of(int n, unsigned seed) {
-  const auto p = test::random_packing(n, seed, 0.02, 0.035);
-  FlowEngine e = test::permeameter(1);
-  e.step(p.centre, p.radius, p.walls, 1.0);
-  return e.system();
-}
-
 std::vector<double> solve(const PressureSystem& g, Ordering ordering, bool cholmod_numeric) {
   CholmodSolver s;
   s.set_openmp_teams(cholmod_numeric);  // CHOLMOD's own numeric factorisation, with its teams
@@ -45,7 +38,7 @@ std::string pivot_error(const PressureSystem& g, bool cholmod_numeric) {
 }  // namespace
 
 TEST(SupernodalNumeric, SolvesAsCholmodsFactorisation) {
-  const PressureSystem g = system_of(2000, 11);
+  const PressureSystem g = test::permeameter_system(2000, 11);
   ASSERT_GT(g.n_unknowns(), 5000);
   for (Ordering ordering : {Ordering::kAmd, Ordering::kMetis}) {
     const auto ours = solve(g, ordering, false), theirs = solve(g, ordering, true);
@@ -61,7 +54,7 @@ TEST(SupernodalNumeric, SolvesAsCholmodsFactorisation) {
 }
 
 TEST(SupernodalNumeric, ReportsTheFirstNonPositivePivotAsCholmodDoes) {
-  PressureSystem g = system_of(400, 12);
+  PressureSystem g = test::permeameter_system(400, 12);
   // Unknown n/2's diagonal (the last stored entry of its column of the upper triangle) made
   // negative: G is no longer positive definite.
   const int u = g.n_unknowns() / 2;

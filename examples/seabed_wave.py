@@ -63,7 +63,8 @@ def build(sample, settings=None):
     # The collective viscous limit of the bed (below the single-grain dt_MV) is known once the engine
     # has a mesh: one short step, then 0.6 of the engine's critical step (it warns above 0.8). The
     # short step stays below the guard's 0.8 x limit for collective limits down to 0.125 dt_MV; the
-    # dense 5000-grain bed has 0.31 dt_MV, the loose one 0.55.
+    # dense 5000-grain bed has 0.31 dt_MV, the loose one 0.55 (summary.json "time_steps" of
+    # wave_standing.py --duration=0.002, with --friction=1 for the dense bed).
     first = 0.1 * min(utils.PWaveTimeStep(), flow.viscous_time_step)
     O.dt = first
     O.run(1, True)

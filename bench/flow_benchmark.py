@@ -7,6 +7,8 @@ Run with YADE (the driver re-invokes yade-double on this file for every measurem
                 [--no-multithread] [--no-double] [--oedo-sizes=1000,10000] [--oedo-steps=600] [--oedo-interval=200]
                 [--steady=20]
                 [--gen-threads=T]    (threads of the child that generates a missing packing; default max of --threads)
+    yade-double -n -x bench/flow_benchmark.py --report-only --json=FILE [--out=doc/benchmarks.md]
+                (the report of an earlier full run from its JSON, for a change of the report's layout)
     yade-double -n -x bench/flow_benchmark.py --startup [--sizes=10000,50000] [--rounds=3] [--threads=1]
                 [--steady=5] [--out=doc/benchmarks.md]
 
@@ -131,9 +133,13 @@ def parse_args(argv):
         engine=None,
         child_json=None,
         gen_threads=None,
+        report_only=False,
     )
     for a in argv:
         if a in ('--quick', '--startup'):
+            continue
+        if a == '--report-only':
+            opts['report_only'] = True
             continue
         if a == '--no-memory':
             opts['memory'] = False
@@ -1023,18 +1029,21 @@ def report(opts, machine, packings, summ, mem, command):
     w('')
     w('Machine and software:')
     w('')
+    # The commit and the packings' digests identify a run for comparing JSON files; the report lives in doc/,
+    # which holds no history, so they stay in the JSON (and the log).
     for k, v in machine.items():
-        w('- %s: %s' % (k, v))
+        if k != 'git':
+            w('- %s: %s' % (k, v))
     w('')
     w('### Packings')
     w('')
-    w('| N | box side | porosity | radii min / mean / max | compaction | digest |')
-    w('|---|---|---|---|---|---|')
+    w('| N | box side | porosity | radii min / mean / max | compaction |')
+    w('|---|---|---|---|---|')
     for n in sorted(packings):
         m = packings[n]
-        w('| %d | %.4f | %.4f | %.4f / %.4f / %.4f | %d iter, %.0f s (-j%s) | `%s` |'
+        w('| %d | %.4f | %.4f | %.4f / %.4f / %.4f | %d iter, %.0f s (-j%s) |'
           % (n, m['box'], m['porosity'], m['r_min'], m['r_mean'], m['r_max'], m['iterations'], m['seconds'],
-             m.get('threads', '?'), m.get('digest', '?')))
+             m.get('threads', '?')))
     w('')
     w('Scene: permeameter along y (dp = %g Pa, viscosity %g, p = 0 at ymax), six fixed walls (boundaries at the walls),'
       ' dynamic spheres with friction 30 deg, Newton damping 0.2, no gravity, O.dt = 0.5 P-wave step; the packing is '
@@ -1396,9 +1405,28 @@ def driver(opts, argv):
     return 0
 
 
+def report_only(opts):
+    """The report of an earlier full run, from its JSON (--json), written to --out: for a change of the report's
+    layout, without measuring again. The run's own options come from the command stored in the JSON."""
+    with open(opts['json']) as f:
+        data = json.load(f)
+    if data.get('version') != REPORT_VERSION:
+        raise SystemExit('flow_benchmark: %s has layout version %s, this script writes %s'
+                         % (opts['json'], data.get('version'), REPORT_VERSION))
+    run = parse_args(data['command'].split()[4:])
+    packings = {int(n): m for n, m in data['packings'].items() if int(n) in run['sizes']}
+    summ, mem = summarise(data['timing'], data['memory_raw'])
+    text = report(run, data['machine'], packings, summ, mem, data['command'])
+    write_report(opts['out'], text)
+    log('report of %s written to %s' % (opts['json'], opts['out']))
+    return 0
+
+
 def main(argv):
     opts = parse_args(argv)
     child = opts['child']
+    if opts['report_only']:
+        return report_only(opts)
     if child is None:
         return startup_driver(opts, argv) if opts['startup'] else driver(opts, argv)
     try:

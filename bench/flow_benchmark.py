@@ -665,18 +665,21 @@ def startup_summary(data):
                         ('factorization', tf['factorization'], tr['factorization']),
                         ('triangulation + geometry', tf['triangulation'] + tf['geometry'],
                          tr['triangulation'] + tr['geometry']),
-                        ('collective limit', cold[0]['seconds'] if cold else 0.0, warm[0]['seconds'] if warm else 0.0),
+                        ('time-step guard', sum(g['seconds'] for g in cold), sum(g['seconds'] for g in warm)),
                         ('python + exchange', x['first']['exec'][0] - x['first']['core_step'][0],
                          x['remesh']['exec'][0] - x['remesh']['core_step'][0])):
                     parts.setdefault(key, []).append((a, b))
-                parts.setdefault('applications', []).append((cold[0]['iterations'] if cold else 0,
-                                                             warm[0]['iterations'] if warm else 0))
+                parts.setdefault('applications', []).append((sum(g['iterations'] for g in cold),
+                                                             sum(g['iterations'] for g in warm)))
+                parts.setdefault('methods', []).append(('+'.join(g.get('method', '?') for g in cold),
+                                                        '+'.join(g.get('method', '?') for g in warm)))
                 parts.setdefault('factor nonzeros', []).append((x['factor_nonzeros'], x['factor_nonzeros']))
+            pair_medians = {k: v[0] if k == 'methods' else (median([a for a, _ in v]), median([b for _, b in v]))
+                            for k, v in parts.items()}
             row[kind] = dict(first=median(first), remesh=median(remesh), ratio=median(ratio),
                              first_range=(min(first), max(first)), ratio_range=(min(ratio), max(ratio)),
                              cpu_share=median(cpu),
-                             parts={k: (median([a for a, _ in v]), median([b for _, b in v]))
-                                    for k, v in parts.items()})
+                             parts=pair_medians)
         row['pfv_over_yade_first'] = row['pfv']['first'] / row['yade']['first']
         rows[n] = row
     return rows
@@ -702,18 +705,20 @@ def startup_report(opts, machine, rows, command, threads):
             n, r['cells'], fmt_t(y['first']), fmt_t(p['first']), fmt_t(p['remesh']), p['ratio'],
             p['ratio_range'][0], p['ratio_range'][1], r['pfv_over_yade_first'], y['cpu_share'], p['cpu_share']))
     w('')
-    w('PFV, first step / forced remesh, by stage (medians; `remesh_times()`, the collective limit from '
-      '`collective_viscous_history`: cold Arnoldi on the first mesh, warm power iteration on the remesh; python + '
-      'exchange = execTime minus the core step, guard included):')
+    w('PFV, first step / forced remesh, by stage (medians; `remesh_times()`; the time-step guard from '
+      '`collective_viscous_history`: the certified bound, and the collective limit itself where the bound '
+      'cannot show O.dt safe, "methods" as recorded in the first round; python + exchange = execTime minus the '
+      'core step, guard included):')
     w('')
-    keys = ('ordering', 'factorization', 'triangulation + geometry', 'collective limit', 'python + exchange')
-    w('| N | ' + ' | '.join(keys) + ' | operator applications | nnz(L) |')
-    w('|---|' + '---|' * (len(keys) + 2))
+    keys = ('ordering', 'factorization', 'triangulation + geometry', 'time-step guard', 'python + exchange')
+    w('| N | ' + ' | '.join(keys) + ' | guard methods | operator applications | nnz(L) |')
+    w('|---|' + '---|' * (len(keys) + 3))
     for n, r in rows.items():
         pp = r['pfv']['parts']
         cells = ['%s / %s' % (fmt_t(pp[k][0]), fmt_t(pp[k][1])) for k in keys]
-        w('| %s | %s | %d / %d | %.3g |' % (n, ' | '.join(cells), pp['applications'][0], pp['applications'][1],
-                                            pp['factor nonzeros'][0]))
+        w('| %s | %s | %s / %s | %d / %d | %.3g |' % (
+            n, ' | '.join(cells), pp['methods'][0] or '-', pp['methods'][1] or '-', pp['applications'][0],
+            pp['applications'][1], pp['factor nonzeros'][0]))
     w('')
     w('Load average (1, 5, 15 min) at start: %s; at end: %s.'
       % (machine['load average at start'], machine['load average at end']))

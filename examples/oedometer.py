@@ -669,7 +669,8 @@ def run(opts):
     if opts['engine'] == 'pfv':
         summary['remesh_count'] = flow.core.remesh_count
         # the engine's collective viscous limit, recomputed at every remesh (doc/validation.md section 4)
-        hist = [h for h in flow.collective_viscous_history if math.isfinite(h['limit'])]  # not the permeameter's
+        # the limits themselves (not their bounds), and not the permeameter's
+        hist = [h for h in flow.collective_viscous_history if h['method'] != 'bound' and math.isfinite(h['limit'])]
         summary['collective_limit_over_dt'] = [h['limit'] / O.dt for h in hist]
         summary['collective_limit_seconds'] = [h['seconds'] for h in hist]
         if hist:

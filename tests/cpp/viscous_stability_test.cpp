@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
 
 #include "pfv/engine/flow_engine.hpp"
 #include "test_packings.hpp"
@@ -112,4 +113,55 @@ TEST(ViscousStability, TheOperatorIsLinearInTheVelocities) {
   ASSERT_GT(scale, 0);
   EXPECT_LT(additivity, 1e-6 * scale);
   EXPECT_LT(homogeneity, 1e-6 * scale);
+}
+
+// The certified bound lies below the limit of the dense spectrum whatever solves G: the double
+// factor, the 32-bit one (whose single substitution the bound's own check must refine), the
+// multigrid CG, and with the storage term of a compressible fluid. It is loose by design; how
+// loose is printed, and it must stay useful (within four orders of magnitude here).
+TEST(ViscousStability, TheBoundIsBelowTheLimitOfTheDenseSpectrum) {
+  const auto p = test::random_packing(120, 5, 0.06, 0.09);
+  struct Variant {
+    const char* name;
+    SolverKind solver;
+    bool mixed;
+    double bulk_modulus;
+  };
+  for (const Variant& variant : {Variant{"double factor", SolverKind::kCholesky, false, 0},
+                                 Variant{"32-bit factor", SolverKind::kCholesky, true, 0},
+                                 Variant{"multigrid", SolverKind::kMultigrid, false, 0},
+                                 Variant{"compressible", SolverKind::kCholesky, false, 2.2e9}}) {
+    SCOPED_TRACE(variant.name);
+    FlowEngine e = test::permeameter(1);
+    e.settings.conductance.viscosity = 10;
+    e.settings.solver = variant.solver;
+    e.settings.mixed_precision = variant.mixed;
+    e.settings.mixed_precision_min_entries = 0;
+    e.settings.fluid_bulk_modulus = variant.bulk_modulus;
+    e.step(p.centre, p.radius, p.walls, 1e-4);
+    e.step(p.centre, p.radius, p.walls, 1e-4);
+    std::vector<double> mass(p.radius.size());
+    for (std::size_t k = 0; k < mass.size(); ++k) mass[k] = 2600 * 4.0 / 3 * M_PI * std::pow(p.radius[k], 3);
+    mass[3] = 0;
+    const double limit = 2 / dense_reference(e, mass).lambda_max;
+    const double bound = e.viscous_stability_bound(mass);
+    std::printf("  %s: bound / limit = %.3g\n", variant.name, bound / limit);
+    EXPECT_GT(bound, 0);
+    EXPECT_LE(bound, limit * (1 - 1e-9));
+    EXPECT_GT(bound, 1e-4 * limit);
+  }
+}
+
+TEST(ViscousStability, NoBoundWithTheShearTermOrWithoutAMesh) {
+  const auto p = test::random_packing(60, 3, 0.06, 0.09);
+  std::vector<double> mass(p.radius.size(), 1.0);
+  FlowEngine e = test::permeameter(1);
+  EXPECT_THROW(e.viscous_stability_bound(mass), std::logic_error);
+  e.settings.viscous_shear = true;
+  e.step(p.centre, p.radius, p.walls, 1e-4);
+  EXPECT_EQ(e.viscous_stability_bound(mass), 0);
+  std::vector<double> bad = mass;
+  bad[2] = std::nan("");
+  EXPECT_THROW(e.viscous_stability_bound(bad), std::invalid_argument);
+  EXPECT_THROW(e.viscous_stability_bound(std::vector<double>(5, 1.0)), std::invalid_argument);
 }

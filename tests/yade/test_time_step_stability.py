@@ -20,8 +20,10 @@ Checks
    operator, 2 / lambda_max of M^-1 V), which is below dt_MV on this dense packing (the thesis' 0.8 dt_MV blows up
    here within 20 steps). O.dt = time_step_safety * critical_time_step, the largest step the engine accepts silently,
    is stable by the same criterion, and no warning is given.
-6. The collective limit is recomputed at every remesh (warm-started power iteration). The packing compacted by 1 %
-   (positions scaled about the centre, walls with them, relaxed without fluid) has a lower limit. A run at the step
+6. The collective limit is recomputed at every remesh (warm-started power iteration) where its certified
+   bound (asked first, about one solve) cannot show O.dt safe; at 1e-4 dt_MV the bound suffices, no limit is
+   computed. The packing compacted by 1 % (positions scaled about the centre, walls with them, relaxed without
+   fluid) has a lower limit. A run at the step
    the engine accepted silently on the loose packing is moved onto the compacted one and remeshed: the engine warns
    once, at that step (it had been safe until then), and the run then blows up; with strict_time_step the remesh
    step raises; time_step_safety * critical_time_step of the compacted packing is stable without a warning.
@@ -234,7 +236,8 @@ check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
 
 # 6. the limit follows the compaction: recomputed at the remesh, warned there ------------------------------------------
 flow = build()
-O.dt = 1e-3 * flow.viscous_time_step
+O.dt = 1e-4 * flow.viscous_time_step  # far below the limit: the guard's bound suffices, no limit computed
+first_dt = O.dt
 O.step()
 loose = flow.collective_viscous_time_step
 O.dt = flow.time_step_safety * flow.critical_time_step  # accepted silently on the loose packing (stable, check 5)
@@ -248,7 +251,8 @@ random_velocities()
 ke0 = kinetic()
 it0 = O.iter
 hist, seen, error = run_steps(100, ke0, stop_ratio=1e12)
-history = flow.collective_viscous_history
+records = flow.collective_viscous_history
+history = [h for h in records if h["method"] != "bound"]  # the computations of the limit itself
 dt_warnings = [(i - it0, w) for i, w in seen if issubclass(w.category, TimeStepWarning)]
 print("     collective limit: %s" % "; ".join(
     "%.3f dt_MV at iter %d (%d iterations, %s, %.1f ms)" % (h["limit"] / dt_mv, h["iter"], h["iterations"],
@@ -261,6 +265,18 @@ print("     last remesh %.1f ms; warm-started limit on the compacted packing %.1
 check(len(history) >= 2 and history[1]["warm"] and history[1]["iter"] == it0,
       "the limit was recomputed (warm start) on the new mesh, at the remesh step")
 compacted = history[1]["limit"] if len(history) >= 2 else loose
+# The guard asks the certified bound first: on the loose packing at 1e-4 dt_MV it sufficed (no limit computed by
+# the guard at that step, only by the query after it), on the compacted one at the step near the limit it did not.
+bounds = [h for h in records if h["method"] == "bound"]
+check(len(records) >= 4 and records[0]["method"] == "bound" and records[1]["method"] == "arnoldi"
+      and records[1]["iter"] == records[0]["iter"] + 1 and first_dt <= flow.time_step_safety * records[0]["limit"]
+      and records[2]["method"] == "bound" and records[3]["method"] == "power" and O.dt > 0.8 * records[2]["limit"],
+      "the guard's order: bound on the first mesh (sufficed at 1e-4 dt_MV), the limit when queried; bound on the "
+      "compacted mesh (not enough at %.3g dt_MV), then the limit (got %s)"
+      % (factor, [(h["method"], h["iter"]) for h in records[:4]]))
+check(all(0 < b["limit"] <= h["limit"] for b, h in zip(bounds[:2], history[:2])),
+      "each bound lies below the limit of its mesh (%s)" % "; ".join(
+          "%.3g <= %.3g dt_MV" % (b["limit"] / dt_mv, h["limit"] / dt_mv) for b, h in zip(bounds, history)))
 check(compacted < 0.85 * loose, "compaction by %g %% lowers the collective limit from %.3f to %.3f dt_MV"
       % (100 * (1 - COMPACTION), loose / dt_mv, compacted / dt_mv))
 check(len(dt_warnings) == 1 and dt_warnings[0][0] == 1,

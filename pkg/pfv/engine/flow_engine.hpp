@@ -96,6 +96,10 @@ class FlowEngine {
   // non-finite estimate.
   double viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode = nullptr,
                                  int* applications = nullptr) const;
+  // A lower bound on viscous_stability_limit, certified (see viscous_stability.cpp) and costing
+  // about one solve, but loose: one to three orders of magnitude below the limit. 0 when there is
+  // no bound (viscous shear on, or the pressure matrix not of the form the argument needs).
+  double viscous_stability_bound(const std::vector<double>& mass) const;
   // accel = M^-1 F(v): the fluid forces of the sphere velocities v on the current mesh over
   // the masses (zero for mass <= 0). The operator of viscous_stability_limit; public for tests.
   void apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,
@@ -191,6 +195,8 @@ class FlowEngine {
     std::future<Remesh> result;
   };
 
+  // Throws unless there is a mesh and one finite mass per sphere of it (the stability limits).
+  void check_stability_inputs(const std::vector<double>& mass) const;
   // The stages of step(), in order.
   void validate_step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                      double dt) const;

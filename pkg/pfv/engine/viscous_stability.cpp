@@ -43,6 +43,19 @@ constexpr int kMinKrylov = 8;
 
 }  // namespace
 
+void FlowEngine::check_stability_inputs(const std::vector<double>& mass) const {
+  // Linearised about the positions of the last step, which the mesh holds once a step on it has
+  // succeeded (a forgotten history, reset_history(), does not matter here).
+  if (!has_mesh() || centres_prev_.size() != static_cast<std::size_t>(mesh().n_spheres))
+    throw std::logic_error("the stability limit needs a mesh: run a step first");
+  const int n = mesh().n_spheres;
+  if (static_cast<int>(mass.size()) != n)
+    throw std::invalid_argument("one mass per sphere of the mesh is needed (" + std::to_string(n) + " spheres, " +
+                                std::to_string(mass.size()) + " masses)");
+  for (int k = 0; k < n; ++k)
+    if (!std::isfinite(mass[k])) throw std::invalid_argument("mass of sphere " + std::to_string(k) + " is not finite");
+}
+
 void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,
                                         std::vector<Vec3>& accel) const {
   const int n = mesh().n_spheres, nc = mesh().n_cells();
@@ -72,19 +85,116 @@ void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const s
   for (int k = 0; k < n; ++k) accel[k] = mass[k] > 0 ? Vec3(force[k] / mass[k]) : Vec3::Zero();
 }
 
+// A certified lower bound on the limit, cheap enough to take the place of the iteration when the
+// time step is far below it (any water-filled packing at a DEM time step). With A = M^-1 S G^-1 B
+// (B: sphere velocities to cell volume rates, G: the pressure matrix, S: the force cache), every
+// eigenvalue satisfies |lambda| <= ||A||_inf, and because G is a Stieltjes matrix (symmetric,
+// positive definite, off-diagonal entries <= 0) G^-1 is entrywise nonnegative, so
+//   ||A||_inf <= max over sphere components (s, a) of (|S| G^-1 beta)_(s,a) / m_s,
+// beta_c = sum of |dV_c / dx_(k,b)| over the moving spheres k of cell c and the axes b.
+// One solve gives G^-1 beta. It is checked rather than trusted: z counts as an upper bound of
+// G^-1 beta only where G z >= beta holds entry by entry (then z - G^-1 beta = G^-1 (G z - beta)
+// >= 0), which also covers a reduced-precision factor and an iterative solver. The bound loses
+// the cancellations of the true operator (a uniform pressure pushes no interior sphere) and G^-1
+// spreads a local source over the sample, so it sits one to three orders of magnitude above
+// lambda_max on the packings measured: good enough to show a small step safe, never to find the
+// limit. The optional shear term is not covered: with it there is no bound.
+double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) const {
+  check_stability_inputs(mass);
+  if (mesh_->shear) return 0;
+  const PressureSystem& system = linear_.system;
+  const int nu = system.n_unknowns();
+  if (nu == 0 || !linear_.ready()) return HUGE_VAL;
+  for (int col = 0; col < nu; ++col)  // the sign pattern G^-1 >= 0 rests on
+    for (int e = system.col_start[col]; e < system.col_start[col + 1]; ++e)
+      if (system.row[e] != col && system.value[e] > 0) return 0;
+  double h = 0;  // the operator's probe displacement, so that both differentiate alike
+  for (int a = 0; a < 3; ++a) h = std::max(h, walls_prev_.extent(a));
+  h *= 1e-7;
+  // beta: a tetrahedron's volume gradient at a vertex is a third of the opposite face's area
+  // vector; a wall prism's by central differences along each coordinate of each moving vertex
+  // (its volume is at most quadratic in any one coordinate, so they are exact).
+  std::vector<double> beta(nu, 0.0);
+  std::vector<Vec3> shifted(centres_prev_);
+  double beta_max = 0;
+  for (int u = 0; u < nu; ++u) {
+    const CellShape& shape = mesh_->cells.shape[system.unknown_cell[u]];
+    if (shape.n_walls == 0) {
+      for (int k = 0; k < 4; ++k) {
+        if (!(mass[shape.v[k]] > 0)) continue;
+        const Vec3& a = centres_prev_[shape.v[(k + 1) % 4]];
+        const Vec3 face = (centres_prev_[shape.v[(k + 2) % 4]] - a).cross(centres_prev_[shape.v[(k + 3) % 4]] - a);
+        beta[u] += face.cwiseAbs().sum() / 6;
+      }
+      beta_max = std::max(beta_max, beta[u]);
+      continue;
+    }
+    for (int k = 0; k < 4 - shape.n_walls; ++k) {
+      const int sphere = shape.v[k];
+      if (!(mass[sphere] > 0)) continue;
+      for (int a = 0; a < 3; ++a) {
+        shifted[sphere][a] = centres_prev_[sphere][a] + h;
+        const double plus = cell_volume(shape, shifted, walls_prev_);
+        shifted[sphere][a] = centres_prev_[sphere][a] - h;
+        const double minus = cell_volume(shape, shifted, walls_prev_);
+        shifted[sphere][a] = centres_prev_[sphere][a];
+        beta[u] += std::abs(plus - minus) / (2 * h);
+      }
+    }
+    beta_max = std::max(beta_max, beta[u]);
+  }
+  if (beta_max == 0) return HUGE_VAL;  // nothing moves any pore: no fluid force, no limit
+  // A floor keeps every entry of the target positive, so that the check below has room for
+  // round-off in cells no moving sphere touches; it only raises the bound, by about 1e-6.
+  for (double& b : beta) b += 1e-6 * beta_max;
+
+  // z ~ G^-1 beta, then scaled by q = max beta_u / (G z)_u so that G (q z) >= beta entry by entry.
+  // One substitution of a 32-bit factor leaves q within a few 1e-4 of 1; should it not (q > 2, or
+  // (G z)_u <= 0 somewhere), refinement passes improve z first.
+  constexpr double kMaxScale = 2;
+  constexpr int kMaxPasses = 6;
+  std::vector<double> z, gz(nu), correction, defect(nu);
+  linear_.solver->apply_inverse(system, beta, z, settings.solve_control());
+  double q = HUGE_VAL;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    std::fill(gz.begin(), gz.end(), 0.0);
+    for (int col = 0; col < nu; ++col)  // G z from its upper triangle by columns
+      for (int e = system.col_start[col]; e < system.col_start[col + 1]; ++e) {
+        const int r = system.row[e];
+        gz[r] += system.value[e] * z[col];
+        if (r != col) gz[col] += system.value[e] * z[r];
+      }
+    q = 0;
+    for (int u = 0; u < nu; ++u) {
+      q = gz[u] > 0 ? std::max(q, beta[u] / gz[u]) : HUGE_VAL;
+      if (q == HUGE_VAL) break;
+    }
+    if (q <= kMaxScale) break;
+    if (pass + 1 < kMaxPasses) {
+      for (int u = 0; u < nu; ++u) defect[u] = beta[u] - gz[u];
+      linear_.solver->apply_inverse(system, defect, correction, settings.solve_control());
+      for (int u = 0; u < nu; ++u) z[u] += correction[u];
+    }
+  }
+  if (!(q <= kMaxScale)) return 0;  // G is not the matrix this argument needs, or the solve is poor
+  std::vector<double> z_cells(mesh().n_cells(), 0.0);
+  for (int u = 0; u < nu; ++u) z_cells[system.unknown_cell[u]] = std::max(z[u], 0.0) * q;
+  std::vector<Vec3> rows;
+  mesh_->cache.apply_magnitude(z_cells, rows);
+  double lambda = 0;
+  for (int k = 0; k < mesh().n_spheres; ++k)
+    if (mass[k] > 0) lambda = std::max(lambda, rows[k].maxCoeff() / mass[k]);
+  if (!std::isfinite(lambda))
+    throw std::domain_error("the bound on the collective viscous stability limit is not finite (check the "
+                            "positions, masses and viscosity)");
+  return lambda > 0 ? 2.0 / lambda : HUGE_VAL;
+}
+
 double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode,
                                            int* applications) const {
   if (applications) *applications = 0;
-  // Linearised about the positions of the last step, which the mesh holds once a step on it has
-  // succeeded (a forgotten history, reset_history(), does not matter here).
-  if (!has_mesh() || centres_prev_.size() != static_cast<std::size_t>(mesh().n_spheres))
-    throw std::logic_error("the stability limit needs a mesh: run a step first");
+  check_stability_inputs(mass);
   const int n = mesh().n_spheres;
-  if (static_cast<int>(mass.size()) != n)
-    throw std::invalid_argument("one mass per sphere of the mesh is needed (" + std::to_string(n) + " spheres, " +
-                                std::to_string(mass.size()) + " masses)");
-  for (int k = 0; k < n; ++k)
-    if (!std::isfinite(mass[k])) throw std::invalid_argument("mass of sphere " + std::to_string(k) + " is not finite");
   const int nu = linear_.system.n_unknowns();
   if (nu == 0 || !linear_.ready()) return HUGE_VAL;
 

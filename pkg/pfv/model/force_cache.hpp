@@ -18,6 +18,10 @@ class ForceCache {
   void build(const Mesh& mesh, const FacetGeometry& facets, const Packing& packing);
   // force[v] for every mesh vertex (spheres, then the six walls).
   void apply(const std::vector<double>& cell_pressure, std::vector<Vec3>& force) const;
+  // bound[v][a] = sum over cells c of |S(v, c)[a]| cell_value[c]: with nonnegative values, a
+  // bound on |force[v][a]| for any pressures of magnitude at most cell_value (the row sums of
+  // |S| that the collective time-step bound needs, viscous_stability.cpp).
+  void apply_magnitude(const std::vector<double>& cell_value, std::vector<Vec3>& bound) const;
   int n_vertices() const { return static_cast<int>(start_.size()) - 1; }
 
  private:

@@ -383,6 +383,14 @@ PYBIND11_MODULE(_core, m) {
              return e.viscous_stability_limit(m, iterations);
            }),
            py::arg("masses"), py::arg("iterations") = 40)
+      .def("viscous_stability_bound", exclusive([](const SharedEngine& e, const Array& mass) {
+             auto m = to_vector(mass, "masses");
+             py::gil_scoped_release release;
+             return e.viscous_stability_bound(m);
+           }),
+           py::arg("masses"),
+           "A certified lower bound on viscous_stability_limit for about one solve, one to three orders of\n"
+           "magnitude below it; 0 when there is none (viscous shear on).")
       .def("viscous_stability_mode",
            exclusive([](const SharedEngine& e, const Array& mass, int iterations, py::object start) {
              auto m = to_vector(mass, "masses");

@@ -8,6 +8,12 @@ limit and the mesh and viscosity it was computed for, the mode that warm-starts 
 computation, the history of computations, and whether the step was already reported unsafe (one
 warning on becoming unsafe, not one per step). It knows nothing of YADE: the engine passes it the
 core, the masses and the limits. Kept apart so that the warning logic is readable on its own.
+
+The collective limit costs tens of solves; a certified lower bound on it costs about one
+(``core.viscous_stability_bound``, loose by two to four orders of magnitude). A check first asks
+the bound and computes the limit only when the bound cannot show the step safe, so a step far
+below the limit (water at a DEM time step) never pays for the limit, and a step near it is
+checked against the limit itself, as before.
 """
 from __future__ import annotations
 
@@ -43,6 +49,9 @@ class TimeStepGuard:
         self._computed_for: tuple[float, bool] | None = None  # (viscosity, viscous_shear) of the limit
         self._mesh: int | None = None  # core.remesh_count the limit was computed on
         self._mode: np.ndarray | None = None  # its eigenvector, the next mesh's start
+        self._bound: float | None = None  # the certified lower bound on the limit, and its mesh and key
+        self._bound_mesh: int | None = None
+        self._bound_for: tuple[float, bool] | None = None
         # The latest computations (a long run remeshes without end: the record must not grow).
         self._history: collections.deque[dict[str, Any]] = collections.deque(maxlen=HISTORY_LENGTH)
         self._unsafe = False
@@ -58,11 +67,33 @@ class TimeStepGuard:
         """Whether the core has a mesh, or conductances, the collective limit was not computed for."""
         return core.has_mesh() and (self._mesh != core.remesh_count or self._computed_for != self._key(core))
 
-    def known_limit(self, core: Any) -> float:
-        """The collective limit if already computed for the core's mesh as it is, else inf."""
-        if self._limit is None or self.stale(core) or core.remesh_due():
+    def _bound_stale(self, core: Any) -> bool:
+        return self._bound_mesh != core.remesh_count or self._bound_for != self._key(core)
+
+    def unchecked(self, core: Any) -> bool:
+        """Whether neither the limit nor its bound is known for the core's mesh as it is."""
+        return self.stale(core) and (core.has_mesh() and self._bound_stale(core))
+
+    def limit_to_check(self, core: Any, masses: np.ndarray, dt: float, other_limits: float, iteration: int,
+                       before_step: bool = False) -> float:
+        """The collective limit to check dt against: the limit if computed for the core's mesh as it is,
+        else its certified lower bound when that shows dt safe (dt <= safety * min(bound, other_limits)),
+        else the limit, computed now. Before a step (`before_step`) nothing is computed for a mesh about
+        to be replaced: inf, the check follows on the new mesh."""
+        if not core.has_mesh() or (before_step and core.remesh_due()):
             return float("inf")
-        return self._limit
+        if self._limit is not None and not self.stale(core):
+            return self._limit
+        if self._bound_stale(core):
+            t0 = time.perf_counter()
+            bound = core.viscous_stability_bound(masses)
+            self._bound, self._bound_mesh, self._bound_for = bound, core.remesh_count, self._key(core)
+            self._history.append(dict(
+                iter=iteration, remesh_count=core.remesh_count, limit=bound, iterations=0, max_iterations=0,
+                warm=False, method="bound", seconds=time.perf_counter() - t0))
+        if dt <= self.safety * min(self._bound, other_limits):
+            return self._bound
+        return self.collective_limit(core, masses, iteration)
 
     def collective_limit(self, core: Any, masses: np.ndarray, iteration: int) -> float:
         """The collective viscous limit of the core's mesh, computed again on a new mesh or when the
@@ -72,7 +103,10 @@ class TimeStepGuard:
         key = self._key(core)
         if self.stale(core):
             mode = self._mode
-            warm = mode is not None and len(mode) == len(masses) and self._limit is not None
+            # Warm only from the mesh just before: a mode older than that (meshes the bound sufficed
+            # for) may be far from the new one, and power iteration is only accurate from close by.
+            warm = (mode is not None and len(mode) == len(masses) and self._limit is not None
+                    and self._mesh == core.remesh_count - 1)
             iterations = self.iterations_warm if warm else self.iterations
             t0 = time.perf_counter()
             limit, mode, applied = core.viscous_stability_mode(masses, iterations, mode if warm else None)
@@ -83,7 +117,7 @@ class TimeStepGuard:
             self._mesh = core.remesh_count
             self._history.append(dict(
                 iter=iteration, remesh_count=core.remesh_count, limit=limit, iterations=applied,
-                max_iterations=iterations, warm=warm, seconds=seconds))
+                max_iterations=iterations, warm=warm, method="power" if warm else "arnoldi", seconds=seconds))
         return self._limit
 
     @property

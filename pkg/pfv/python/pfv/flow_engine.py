@@ -366,7 +366,7 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
             core.gravity = _gravity(scene)
         # Before the step, only limits known for the mesh the step will use (a mesh about to be
         # rebuilt, or conductances about to change, have no limit yet: checked after the step).
-        self._check_time_step(scene.dt, scan, collective=self._guard.known_limit(core))
+        self._check_time_step(scene.dt, scan, before_step=True)
         remeshing = core.remesh_due()
         inversions, meshes = core.inversion_remeshes, core.remesh_count
         before = (core.remesh_count, core.system_builds) if self._after_step_reports else None
@@ -386,7 +386,7 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
         self._last_step = (scene.iter, scene.time, dt)  # dt: the time this step's dV/dt spanned
         _holding.add(self._key)
         _release_unused(self)
-        if self._guard.stale(core):
+        if self._guard.unchecked(core):
             # A new mesh (the first, or a remesh adopted by this step) or new conductances: its
             # collective limit may be lower (a compacting sample), check again.
             self._check_time_step(scene.dt, scan)
@@ -448,10 +448,11 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
         """2 / lambda_max(M^-1 V) of the current mesh: the viscous limit of the explicit coupling
         for collective motions (groups of spheres squeezing shared pores), which the thesis'
         single-particle dt_MV overestimates (0.3-0.5 dt_MV measured on dense packings).
-        Computed on every new mesh and when the viscosity changes: on the first mesh by Arnoldi
-        from a fixed start (at most collective_iterations = 40 operator applications, stopping
-        once the estimate settles to 1e-6 or its Arnoldi residual is below 1e-3 of it), afterwards
-        by power iteration started from the previous mesh's mode (at most
+        Computed when asked for, or by the time-step guard on a new mesh (or a new viscosity) when
+        the certified bound on it (collective_viscous_bound) cannot show O.dt safe: by Arnoldi from
+        a fixed start (at most collective_iterations = 40 operator applications, stopping once the
+        estimate settles to 1e-6 or its Arnoldi residual is below 1e-3 of it), or by power iteration
+        started from the mode of the mesh just before, if computed there (at most
         collective_iterations_warm = 10). Each operator application
         costs one back-substitution and one force evaluation; see collective_viscous_history
         ("iterations" there is the count made, "max_iterations" the cap, "seconds" the cost)."""
@@ -462,10 +463,21 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
             return self._guard.collective_limit(self._core, self._stepped.masses, yade.O.iter)
 
     @property
+    def collective_viscous_bound(self) -> float:
+        """A certified lower bound on collective_viscous_time_step for about one solve, loose by two to
+        four orders of magnitude (core.viscous_stability_bound); 0 with viscousShear, which it does not
+        cover. What the time-step guard checks O.dt against first."""
+        with self._lock:
+            if not self._core.has_mesh() or self._stepped is None:
+                return float("inf")
+            return self._core.viscous_stability_bound(self._stepped.masses)
+
+    @property
     def collective_viscous_history(self) -> list[dict[str, Any]]:
-        """One dict per computation of the collective limit: iter, remesh_count, limit [s],
-        iterations (operator applications made, each a solve and a force evaluation), max_iterations (the cap),
-        warm (power iteration from the previous mode; cold: Arnoldi), seconds (wall time)."""
+        """One dict per computation of the collective limit or its bound: iter, remesh_count, limit [s],
+        method ("bound": the certified lower bound; "arnoldi"; "power": from the previous mesh's mode),
+        iterations (operator applications made, each a solve and a force evaluation), max_iterations
+        (the cap), warm (method == "power"), seconds (wall time)."""
         return self._guard.history
 
     @property
@@ -476,15 +488,18 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
             scan = self._scanned()
             return min(self.viscous_time_step, self.collective_viscous_time_step, scan.dt_dem)
 
-    def _check_time_step(self, dt: float, scan: SceneScan | None = None, collective: float | None = None) -> None:
+    def _check_time_step(self, dt: float, scan: SceneScan | None = None, before_step: bool = False) -> None:
         """Warn or raise (strict_time_step) if dt exceeds time_step_safety * critical_time_step,
-        with the single-particle and DEM limits of `scan` (None: the current scan) and the given
-        collective limit (None: that of the current mesh, computed if needed)."""
+        with the single-particle and DEM limits of `scan` (None: the current scan) and the collective
+        limit of the current mesh, or its certified bound where that suffices (_time_step.py).
+        `before_step`: the mesh may be about to change, nothing is computed for it then."""
         if scan is None:
             scan = self._scanned()
         dt_mv = viscous_time_step(scan.mass_per_diameter, self._core.viscosity)
-        if collective is None:
-            collective = self.collective_viscous_time_step
+        collective = float("inf")
+        if self._stepped is not None:  # the masses of the spheres the mesh holds
+            collective = self._guard.limit_to_check(self._core, self._stepped.masses, dt, min(dt_mv, scan.dt_dem),
+                                                    yade.O.iter, before_step)
         self._guard.check(dt, dt_mv, collective, scan.dt_dem)
 
     def emulateAction(self) -> None:

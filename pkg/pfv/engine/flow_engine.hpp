@@ -97,7 +97,7 @@ class FlowEngine {
   double viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode = nullptr,
                                  int* applications = nullptr) const;
   // A lower bound on viscous_stability_limit, certified (see viscous_stability.cpp) and costing
-  // about one solve, but loose: one to three orders of magnitude below the limit. 0 when there is
+  // about one solve, but loose: up to four orders of magnitude below the limit. 0 when there is
   // no bound (viscous shear on, or the pressure matrix not of the form the argument needs).
   double viscous_stability_bound(const std::vector<double>& mass) const;
   // accel = M^-1 F(v): the fluid forces of the sphere velocities v on the current mesh over

@@ -96,7 +96,7 @@ void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const s
 // G^-1 beta only where G z >= beta holds entry by entry (then z - G^-1 beta = G^-1 (G z - beta)
 // >= 0), which also covers a reduced-precision factor and an iterative solver. The bound loses
 // the cancellations of the true operator (a uniform pressure pushes no interior sphere) and G^-1
-// spreads a local source over the sample, so it sits one to three orders of magnitude above
+// spreads a local source over the drainage path, so it sits up to four orders of magnitude above
 // lambda_max on the packings measured: good enough to show a small step safe, never to find the
 // limit. The optional shear term is not covered: with it there is no bound.
 double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) const {

@@ -389,7 +389,7 @@ PYBIND11_MODULE(_core, m) {
              return e.viscous_stability_bound(m);
            }),
            py::arg("masses"),
-           "A certified lower bound on viscous_stability_limit for about one solve, one to three orders of\n"
+           "A certified lower bound on viscous_stability_limit for about one solve, up to four orders of\n"
            "magnitude below it; 0 when there is none (viscous shear on).")
       .def("viscous_stability_mode",
            exclusive([](const SharedEngine& e, const Array& mass, int iterations, py::object start) {

@@ -10,7 +10,7 @@ warning on becoming unsafe, not one per step). It knows nothing of YADE: the eng
 core, the masses and the limits. Kept apart so that the warning logic is readable on its own.
 
 The collective limit costs tens of solves; a certified lower bound on it costs about one
-(``core.viscous_stability_bound``, loose by two to four orders of magnitude). A check first asks
+(``core.viscous_stability_bound``, loose by up to four orders of magnitude). A check first asks
 the bound and computes the limit only when the bound cannot show the step safe, so a step far
 below the limit (water at a DEM time step) never pays for the limit, and a step near it is
 checked against the limit itself, as before.

@@ -464,7 +464,7 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
 
     @property
     def collective_viscous_bound(self) -> float:
-        """A certified lower bound on collective_viscous_time_step for about one solve, loose by two to
+        """A certified lower bound on collective_viscous_time_step for about one solve, loose by up to
         four orders of magnitude (core.viscous_stability_bound); 0 with viscousShear, which it does not
         cover. What the time-step guard checks O.dt against first."""
         with self._lock:

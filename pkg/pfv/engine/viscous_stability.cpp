@@ -185,8 +185,9 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
   for (int k = 0; k < mesh().n_spheres; ++k)
     if (mass[k] > 0) lambda = std::max(lambda, rows[k].maxCoeff() / mass[k]);
   if (!std::isfinite(lambda))
-    throw std::domain_error("the bound on the collective viscous stability limit is not finite (check the "
-                            "positions, masses and viscosity)");
+    throw std::domain_error(
+        "the bound on the collective viscous stability limit is not finite (check the "
+        "positions, masses and viscosity)");
   return lambda > 0 ? 2.0 / lambda : HUGE_VAL;
 }
 

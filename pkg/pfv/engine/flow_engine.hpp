@@ -96,10 +96,13 @@ class FlowEngine {
   // non-finite estimate.
   double viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode = nullptr,
                                  int* applications = nullptr) const;
-  // A lower bound on viscous_stability_limit, certified (see viscous_stability.cpp) and costing
-  // about one solve, but loose: up to four orders of magnitude below the limit. 0 when there is
-  // no bound (viscous shear on, or the pressure matrix not of the form the argument needs).
+  // Certified lower bounds on viscous_stability_limit (viscous_stability_bounds.cpp), 0 where
+  // there is none (viscous shear on, or the pressure matrix not of the form the argument needs).
+  // The global bound costs about one solve and lies up to four orders of magnitude below the
+  // limit, the further the longer the drainage path; the local bound solves only small problems
+  // around each sphere, costs more at these sizes, and lies within an order of magnitude.
   double viscous_stability_bound(const std::vector<double>& mass) const;
+  double viscous_stability_local_bound(const std::vector<double>& mass) const;
   // accel = M^-1 F(v): the fluid forces of the sphere velocities v on the current mesh over
   // the masses (zero for mass <= 0). The operator of viscous_stability_limit; public for tests.
   void apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,

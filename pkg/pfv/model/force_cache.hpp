@@ -6,6 +6,7 @@
 // projected footprint of the cell. Applying it is one pass, grouped by vertex so that
 // threads never write the same force.
 #pragma once
+#include <span>
 #include <vector>
 
 #include "triangulation/mesh.hpp"
@@ -23,6 +24,9 @@ class ForceCache {
   // |S| that the collective time-step bound needs, viscous_stability.cpp).
   void apply_magnitude(const std::vector<double>& cell_value, std::vector<Vec3>& bound) const;
   int n_vertices() const { return static_cast<int>(start_.size()) - 1; }
+  // Vertex v's terms: force[v] = sum over k of cell_pressure[cells(v)[k]] * units(v)[k].
+  std::span<const int> cells(int v) const { return {cell_.data() + start_[v], cell_.data() + start_[v + 1]}; }
+  std::span<const Vec3> units(int v) const { return {unit_.data() + start_[v], unit_.data() + start_[v + 1]}; }
 
  private:
   std::vector<int> start_;  // per vertex, into cell_/unit_

@@ -391,6 +391,14 @@ PYBIND11_MODULE(_core, m) {
            py::arg("masses"),
            "A certified lower bound on viscous_stability_limit for about one solve, up to four orders of\n"
            "magnitude below it; 0 when there is none (viscous shear on).")
+      .def("viscous_stability_local_bound", exclusive([](const SharedEngine& e, const Array& mass) {
+             auto m = to_vector(mass, "masses");
+             py::gil_scoped_release release;
+             return e.viscous_stability_local_bound(m);
+           }),
+           py::arg("masses"),
+           "A certified lower bound on viscous_stability_limit from small problems around each sphere, within an\n"
+           "order of magnitude of it; 0 when there is none (viscous shear on).")
       .def("viscous_stability_mode",
            exclusive([](const SharedEngine& e, const Array& mass, int iterations, py::object start) {
              auto m = to_vector(mass, "masses");

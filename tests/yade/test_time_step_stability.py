@@ -18,8 +18,9 @@ Checks
    and ends below it), so the scene and the criterion are sound.
 5. After one coupled step the engine knows its collective viscous limit (Arnoldi on its linearised fluid
    operator, 2 / lambda_max of M^-1 V), which is below dt_MV on this dense packing (the thesis' 0.8 dt_MV blows up
-   here within 20 steps). O.dt = time_step_safety * critical_time_step, the largest step the engine accepts silently,
-   is stable by the same criterion, and no warning is given.
+   here within 20 steps), and collective_viscous_bound lies between 0.1 x and 1 x that limit. O.dt =
+   time_step_safety * critical_time_step, the largest step the engine accepts silently, is stable by the same
+   criterion, and no warning is given.
 6. The collective limit is recomputed at every remesh (warm-started power iteration) where its certified
    bound (asked first, about one solve) cannot show O.dt safe; at 1e-4 dt_MV the bound suffices, no limit is
    computed. The packing compacted by 1 % (positions scaled about the centre, walls with them, relaxed without
@@ -229,6 +230,10 @@ print("     collective viscous limit 2 / lambda_max(M^-1 V) = %.4g s = %.3f dt_M
       "linearised fluid operator; the thesis' single-particle dt_MV is not a safe bound for collective modes)"
       % (dt_collective, dt_collective / dt_mv))
 check(dt_collective < dt_mv, "the collective limit is below dt_MV on this dense packing")
+bound = flow.collective_viscous_bound
+check(0.1 * dt_collective < bound <= dt_collective,
+      "collective_viscous_bound %.3g dt_MV: certified below the limit, within an order of magnitude of it"
+      % (bound / dt_mv))
 factor = flow.time_step_safety * flow.critical_time_step / flow.viscous_time_step
 ok, seen = stable_run(factor, "engine limit")
 check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],

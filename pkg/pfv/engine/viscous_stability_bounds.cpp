@@ -184,9 +184,9 @@ double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass
   constexpr double kZeroSum = 1e-6;  // relative to the sum of magnitudes; round-off is near 1e-10
   const double h = probe_step(walls_prev_);
   std::vector<Vec3> shifted(centres_prev_);
-  std::vector<int> slot(nc, -1), root;
+  std::vector<int> slot(nc, -1), root, part;
   std::vector<char> grounded;
-  Eigen::MatrixXd L, rhs, x;
+  Eigen::MatrixXd L, rhs;
   double b_max = 0, f_max = 0;
   for (int s = 0; s < n; ++s) {
     const int first = cell_start[s], m = cell_start[s + 1] - first;
@@ -197,6 +197,7 @@ double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass
     };
     L.setZero(m, m);
     root.resize(m);
+    part.resize(m);
     std::iota(root.begin(), root.end(), 0);
     grounded.assign(m, 0);
     const auto find = [&](int i) {
@@ -233,17 +234,19 @@ double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass
         }
         rhs.block<1, 3>(slot[cells[k]], 3) += units[k].transpose();
       }
-    for (int i = 0; i < m; ++i)
-      if (grounded[i]) grounded[find(i)] = 1;
+    for (int i = 0; i < m; ++i) {
+      part[i] = find(i);
+      if (grounded[i]) grounded[part[i]] = 1;
+    }
     // On a part that reaches no Dirichlet cell, adding (mu / size) 1 1' changes nothing that L^+
     // does to right-hand sides summing to zero there, and makes the matrix positive definite.
     for (int r = 0; r < m; ++r) {
-      if (find(r) != r || grounded[r]) continue;
+      if (part[r] != r || grounded[r]) continue;
       int size = 0;
       double diagonal = 0;
       Eigen::Matrix<double, 1, 6> sum = Eigen::Matrix<double, 1, 6>::Zero(), magnitude = sum;
       for (int i = 0; i < m; ++i)
-        if (find(i) == r) {
+        if (part[i] == r) {
           ++size;
           diagonal += L(i, i);
           sum += rhs.row(i);
@@ -255,19 +258,23 @@ double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass
           return 0;
         }
       const double shift = (diagonal > 0 ? diagonal : 1.0) / (size * size);
-      for (int i = 0; i < m; ++i)
-        if (find(i) == r)
-          for (int j = 0; j < m; ++j)
-            if (find(j) == r) L(i, j) += shift;
+      for (int j = 0; j < m; ++j)
+        if (part[j] == r)
+          for (int i = 0; i < m; ++i)
+            if (part[i] == r) L(i, j) += shift;
     }
     release();
+    // With L = C C', r' L^-1 r = |C^-1 r|^2: one triangular solve.
     Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(L);
     if (llt.info() != Eigen::Success) return 0;
-    x = llt.solve(rhs);
-    const Eigen::Matrix<double, 6, 6> k = rhs.transpose() * x;
+    llt.matrixL().solveInPlace(rhs);
+    const Eigen::Matrix<double, 6, 6> k = rhs.transpose() * rhs;
     using Eigen3 = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>;
-    b_max = std::max(b_max, Eigen3(k.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly).eigenvalues()[2] / mass[s]);
-    f_max = std::max(f_max, Eigen3(k.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly).eigenvalues()[2] / mass[s]);
+    const auto largest = [](const Eigen::Matrix3d& a) {
+      return Eigen3().computeDirect(a, Eigen::EigenvaluesOnly).eigenvalues()[2];
+    };
+    b_max = std::max(b_max, largest(k.topLeftCorner<3, 3>()) / mass[s]);
+    f_max = std::max(f_max, largest(k.bottomRightCorner<3, 3>()) / mass[s]);
   }
   const double lambda = 3 * std::sqrt(b_max * f_max);
   if (!std::isfinite(lambda))

@@ -200,6 +200,9 @@ class FlowEngine {
 
   // Throws unless there is a mesh and one finite mass per sphere of it (the stability limits).
   void check_stability_inputs(const std::vector<double>& mass) const;
+  // The displacement by which the stability limit and its bounds difference cell volumes: a tiny
+  // fraction of the box, the same for all of them so that they differentiate alike.
+  double volume_probe_step() const;
   // The stages of step(), in order.
   void validate_step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                      double dt) const;

@@ -56,14 +56,18 @@ void FlowEngine::check_stability_inputs(const std::vector<double>& mass) const {
     if (!std::isfinite(mass[k])) throw std::invalid_argument("mass of sphere " + std::to_string(k) + " is not finite");
 }
 
+double FlowEngine::volume_probe_step() const {
+  double h = 0;
+  for (int a = 0; a < 3; ++a) h = std::max(h, walls_prev_.extent(a));
+  return 1e-7 * h;
+}
+
 void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,
                                         std::vector<Vec3>& accel) const {
   const int n = mesh().n_spheres, nc = mesh().n_cells();
   const PressureSystem& system = linear_.system;
   const int nu = system.n_unknowns();
-  double h = 0;  // probe displacement: a tiny fraction of the box
-  for (int a = 0; a < 3; ++a) h = std::max(h, walls_prev_.extent(a));
-  h *= 1e-7;
+  const double h = volume_probe_step();
   std::vector<Vec3> shifted(centres_prev_), force, shear;
   std::vector<double> rhs(nu), x, p_cells(nc, 0.0);
   // dV/dt for the velocity v, by central differences (cell volumes are smooth in x).

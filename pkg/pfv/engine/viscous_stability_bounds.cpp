@@ -12,6 +12,7 @@
 
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/engine/pore_mesh.hpp"
+#include "pfv/linalg/refinement.hpp"
 
 namespace pfv {
 namespace {
@@ -21,12 +22,6 @@ bool stieltjes(const PressureSystem& system) {
     for (int e = system.col_start[col]; e < system.col_start[col + 1]; ++e)
       if (system.row[e] != col && system.value[e] > 0) return false;
   return true;
-}
-
-double probe_step(const BoxWalls& walls) {  // the operator's, so that both differentiate alike
-  double h = 0;
-  for (int a = 0; a < 3; ++a) h = std::max(h, walls.extent(a));
-  return 1e-7 * h;
 }
 
 // d|V_c| / dx of sphere vertex k of a cell (dV/dt differentiates the total volume, unsigned): for
@@ -74,7 +69,7 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
   const int nu = system.n_unknowns();
   if (nu == 0 || !linear_.ready()) return HUGE_VAL;
   if (!stieltjes(system)) return 0;
-  const double h = probe_step(walls_prev_);
+  const double h = volume_probe_step();
   std::vector<double> beta(nu, 0.0);
   std::vector<Vec3> shifted(centres_prev_);
   double beta_max = 0;
@@ -94,25 +89,18 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
   // (G z)_u <= 0 somewhere), refinement passes improve z first.
   constexpr double kMaxScale = 2;
   constexpr int kMaxPasses = 6;
-  std::vector<double> z, gz(nu), correction, defect(nu);
+  std::vector<double> z, correction, defect;
   linear_.solver->apply_inverse(system, beta, z, settings.solve_control());
   double q = HUGE_VAL;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
-    std::fill(gz.begin(), gz.end(), 0.0);
-    for (int col = 0; col < nu; ++col)  // G z from its upper triangle by columns
-      for (int e = system.col_start[col]; e < system.col_start[col + 1]; ++e) {
-        const int r = system.row[e];
-        gz[r] += system.value[e] * z[col];
-        if (r != col) gz[col] += system.value[e] * z[r];
-      }
+    residual(system, beta, z, defect);  // beta - G z
     q = 0;
-    for (int u = 0; u < nu; ++u) {
-      q = gz[u] > 0 ? std::max(q, beta[u] / gz[u]) : HUGE_VAL;
-      if (q == HUGE_VAL) break;
+    for (int u = 0; u < nu && q < HUGE_VAL; ++u) {
+      const double gz = beta[u] - defect[u];
+      q = gz > 0 ? std::max(q, beta[u] / gz) : HUGE_VAL;
     }
     if (q <= kMaxScale) break;
     if (pass + 1 < kMaxPasses) {
-      for (int u = 0; u < nu; ++u) defect[u] = beta[u] - gz[u];
       linear_.solver->apply_inverse(system, defect, correction, settings.solve_control());
       for (int u = 0; u < nu; ++u) z[u] += correction[u];
     }
@@ -181,8 +169,8 @@ double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass
         for (int v : fg.vertex[f])
           if (v < n) star_facet[next[v]++] = f;
   }
-  constexpr double kZeroSum = 1e-6;  // relative to the sum of magnitudes; round-off is near 1e-10
-  const double h = probe_step(walls_prev_);
+  constexpr double kZeroSum = 1e-6;  // relative to the sum of magnitudes, far above round-off
+  const double h = volume_probe_step();
   std::vector<Vec3> shifted(centres_prev_);
   std::vector<int> slot(nc, -1), root, part;
   std::vector<char> grounded;

@@ -96,6 +96,16 @@ int add_point_condition(FlowEngine& e, std::vector<PointCondition>& list, const 
   return static_cast<int>(list.size()) - 1;
 }
 
+// A const method of the sphere masses (the stability bounds), run without the GIL.
+template <double (FlowEngine::*method)(const std::vector<double>&) const>
+auto of_masses() {
+  return exclusive([](const SharedEngine& e, const Array& mass) {
+    auto m = to_vector(mass, "masses");
+    py::gil_scoped_release release;
+    return (e.*method)(m);
+  });
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -383,20 +393,10 @@ PYBIND11_MODULE(_core, m) {
              return e.viscous_stability_limit(m, iterations);
            }),
            py::arg("masses"), py::arg("iterations") = 40)
-      .def("viscous_stability_bound", exclusive([](const SharedEngine& e, const Array& mass) {
-             auto m = to_vector(mass, "masses");
-             py::gil_scoped_release release;
-             return e.viscous_stability_bound(m);
-           }),
-           py::arg("masses"),
+      .def("viscous_stability_bound", of_masses<&FlowEngine::viscous_stability_bound>(), py::arg("masses"),
            "A certified lower bound on viscous_stability_limit for about one solve, up to four orders of\n"
            "magnitude below it; 0 when there is none (viscous shear on).")
-      .def("viscous_stability_local_bound", exclusive([](const SharedEngine& e, const Array& mass) {
-             auto m = to_vector(mass, "masses");
-             py::gil_scoped_release release;
-             return e.viscous_stability_local_bound(m);
-           }),
-           py::arg("masses"),
+      .def("viscous_stability_local_bound", of_masses<&FlowEngine::viscous_stability_local_bound>(), py::arg("masses"),
            "A certified lower bound on viscous_stability_limit from small problems around each sphere, within an\n"
            "order of magnitude of it; 0 when there is none (viscous shear on).")
       .def("viscous_stability_mode",

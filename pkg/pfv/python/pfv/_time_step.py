@@ -46,33 +46,31 @@ class TimeStepGuard:
         self.iterations = 40          # operator applications at most, cold start (first mesh)
         self.iterations_warm = 10     # operator applications at most, warm start (later meshes)
         self._limit: float | None = None
-        self._computed_for: tuple[float, bool] | None = None  # (viscosity, viscous_shear) of the limit
-        self._mesh: int | None = None  # core.remesh_count the limit was computed on
+        self._limit_state: tuple[int, float, bool] | None = None  # the _state the limit was computed in
         self._mode: np.ndarray | None = None  # its eigenvector, the next mesh's start
-        self._bound: float | None = None  # the certified lower bound on the limit, and its mesh and key
-        self._bound_mesh: int | None = None
-        self._bound_for: tuple[float, bool] | None = None
+        self._bound: float | None = None  # the certified lower bound on the limit
+        self._bound_state: tuple[int, float, bool] | None = None
         # The latest computations (a long run remeshes without end: the record must not grow).
         self._history: collections.deque[dict[str, Any]] = collections.deque(maxlen=HISTORY_LENGTH)
         self._unsafe = False
 
     @staticmethod
-    def _key(core: Any) -> tuple[float, bool]:
-        # The viscosity of the mesh's conductances (a new one applies at the next step), and the
+    def _state(core: Any) -> tuple[int, float, bool]:
+        # The mesh, the viscosity of its conductances (a new one applies at the next step), and the
         # shear term, which adds damping to the operator (switched on, its pairs arrive with a
         # remesh, which recomputes again).
-        return core.mesh_viscosity, core.viscous_shear
+        return core.remesh_count, core.mesh_viscosity, core.viscous_shear
 
     def stale(self, core: Any) -> bool:
         """Whether the core has a mesh, or conductances, the collective limit was not computed for."""
-        return core.has_mesh() and (self._mesh != core.remesh_count or self._computed_for != self._key(core))
-
-    def _bound_stale(self, core: Any) -> bool:
-        return self._bound_mesh != core.remesh_count or self._bound_for != self._key(core)
+        return core.has_mesh() and self._limit_state != self._state(core)
 
     def unchecked(self, core: Any) -> bool:
         """Whether neither the limit nor its bound is known for the core's mesh as it is."""
-        return self.stale(core) and (core.has_mesh() and self._bound_stale(core))
+        if not core.has_mesh():
+            return False
+        state = self._state(core)
+        return self._limit_state != state and self._bound_state != state
 
     def limit_to_check(self, core: Any, masses: np.ndarray, dt: float, other_limits: float, iteration: int,
                        before_step: bool = False) -> float:
@@ -82,14 +80,14 @@ class TimeStepGuard:
         to be replaced: inf, the check follows on the new mesh."""
         if not core.has_mesh() or (before_step and core.remesh_due()):
             return float("inf")
-        if self._limit is not None and not self.stale(core):
+        state = self._state(core)
+        if self._limit_state == state:
             return self._limit
-        if self._bound_stale(core):
+        if self._bound_state != state:
             t0 = time.perf_counter()
-            bound = core.viscous_stability_bound(masses)
-            self._bound, self._bound_mesh, self._bound_for = bound, core.remesh_count, self._key(core)
+            self._bound, self._bound_state = core.viscous_stability_bound(masses), state
             self._history.append(dict(
-                iter=iteration, remesh_count=core.remesh_count, limit=bound, iterations=0, max_iterations=0,
+                iter=iteration, remesh_count=state[0], limit=self._bound, iterations=0, max_iterations=0,
                 warm=False, method="bound", seconds=time.perf_counter() - t0))
         if dt <= self.safety * min(self._bound, other_limits):
             return self._bound
@@ -100,23 +98,21 @@ class TimeStepGuard:
         viscosity or the shear term changed; `iteration` (O.iter) goes into the history."""
         if not core.has_mesh():
             return float("inf")
-        key = self._key(core)
-        if self.stale(core):
+        state = self._state(core)
+        if self._limit_state != state:
             mode = self._mode
             # Warm only from the mesh just before: a mode older than that (meshes the bound sufficed
             # for) may be far from the new one, and power iteration is only accurate from close by.
-            warm = (mode is not None and len(mode) == len(masses) and self._limit is not None
-                    and self._mesh == core.remesh_count - 1)
+            warm = (mode is not None and len(mode) == len(masses) and self._limit_state is not None
+                    and self._limit_state[0] in (state[0], state[0] - 1))
             iterations = self.iterations_warm if warm else self.iterations
             t0 = time.perf_counter()
             limit, mode, applied = core.viscous_stability_mode(masses, iterations, mode if warm else None)
             seconds = time.perf_counter() - t0
-            self._limit = limit
+            self._limit, self._limit_state = limit, state
             self._mode = mode if len(mode) else None
-            self._computed_for = key
-            self._mesh = core.remesh_count
             self._history.append(dict(
-                iter=iteration, remesh_count=core.remesh_count, limit=limit, iterations=applied,
+                iter=iteration, remesh_count=state[0], limit=limit, iterations=applied,
                 max_iterations=iterations, warm=warm, method="power" if warm else "arnoldi", seconds=seconds))
         return self._limit
 

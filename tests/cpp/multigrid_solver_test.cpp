@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
+#include <string>
 
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/linalg/amg_solver.hpp"
@@ -47,6 +49,8 @@ void expect_multigrid_matches_direct(const test::TestPacking& p, int steps) {
   multigrid.settings.solver = SolverKind::kMultigrid;
   std::vector<Vec3> x = p.centre;
   const double dt = 1e-3;
+  double worst_ratio = 0;
+  std::string iterations;
   for (int step = 0; step < steps; ++step) {
     for (std::size_t k = 0; k < x.size(); ++k)  // a slow squeeze along y: dV/dt != 0
       x[k].y() = 0.5 + (p.centre[k].y() - 0.5) * (1 - 2e-4 * step * (1 + 0.1 * step));
@@ -60,10 +64,15 @@ void expect_multigrid_matches_direct(const test::TestPacking& p, int steps) {
     ASSERT_GT(s, 0);
     double worst = 0;
     for (std::size_t c = 0; c < ref.size(); ++c) worst = std::max(worst, std::abs(multigrid.pressure()[c] - ref[c]));
-    // The stopping rule's promise: refinement_tolerance of the spread (its error is estimated
-    // from the contraction of the last iterations; the worst seen here is 0.68 of it).
-    EXPECT_LE(worst, 2 * multigrid.settings.refinement_tolerance * s) << "step " << step;
+    // The stopping rule's promise: refinement_tolerance of the spread (the direct solve's own
+    // error is below 1e-12 of it). The rule estimates the error from the contraction of the
+    // iterations; taking the last two ratios alone broke the promise at seed 5 (1.7 x).
+    EXPECT_LE(worst, multigrid.settings.refinement_tolerance * s) << "step " << step;
+    worst_ratio = std::max(worst_ratio, worst / (multigrid.settings.refinement_tolerance * s));
+    iterations += (step ? " " : "") + std::to_string(multigrid.last_solve().cg_iterations);
   }
+  std::printf("%zu spheres: iterations per step %s; largest error %.2f x refinement_tolerance x spread\n",
+              p.centre.size(), iterations.c_str(), worst_ratio);
 }
 
 }  // namespace
@@ -91,7 +100,12 @@ TEST(Multigrid, FullRowsAreTheSymmetricMatrix) {
       EXPECT_EQ(rows.value[e2], entry(rows.column[e2], i)) << i << " " << rows.column[e2];
 }
 
-TEST(Multigrid, MatchesTheDirectSolveAt10kSpheres) { expect_multigrid_matches_direct(jittered_lattice(22, 3), 8); }
+TEST(Multigrid, MatchesTheDirectSolveAt10kSpheres) {
+  for (unsigned seed : {3u, 5u}) {
+    SCOPED_TRACE(seed);
+    expect_multigrid_matches_direct(jittered_lattice(22, seed), 8);
+  }
+}
 
 TEST(Multigrid, MatchesTheDirectSolveAt50kSpheres) { expect_multigrid_matches_direct(jittered_lattice(37, 4), 3); }
 

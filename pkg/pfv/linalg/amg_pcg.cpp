@@ -225,7 +225,7 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
   std::copy(b.begin(), b.end(), m.b.begin());
   std::copy(x.begin(), x.end(), m.x.begin());
   constexpr double kFirstIterationMargin = 1e-3, kSeedSafety = 2;
-  double previous = 0, ratio = 0, last_ratio = 0, largest = 0;
+  double previous = 0, largest = 0;
   const auto stop = [&](int k, double alpha) {
     double d = 0, lo = m.x.data[0], hi = m.x.data[0], size = 0;
     for (int i = 0; i < m.n; ++i) {
@@ -246,12 +246,9 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
       const double seed = kSeedSafety * seen_ratio_;
       return d <= kFirstIterationMargin * bound || (seed > 0 && seed < 1 && seed / (1 - seed) * d <= bound);
     }
-    last_ratio = ratio;
-    ratio = d / previous;
+    largest = std::max(largest, d / previous);
     previous = d;
-    largest = std::max(largest, ratio);
-    const double rho = std::max(ratio, last_ratio);
-    return rho < 1 && rho / (1 - rho) * d <= bound;
+    return largest < 1 && largest / (1 - largest) * d <= bound;
   };
   AmgSolveStats stats;
   const int k = m.iterate(max_iterations, stop);

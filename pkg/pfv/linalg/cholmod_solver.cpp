@@ -185,9 +185,7 @@ namespace {
 // 4 kB of the factor (10 000 spheres: 41 MB, 10 000 faults), which a remesh, reusing the
 // block, does not pay. Smaller blocks stay on 4 kB pages (a 2 MB page per engine would be
 // most of a small factor). The advice is only advice: without it, or refused, the block works
-// the same. Measured at 10 000 spheres, fresh process, first step: 31 500 -> 17 200 page
-// faults, first factorisation 0.81 -> 0.68 s (medians of 3, 2 cores under load). Returns the
-// capacity in doubles.
+// the same (the measured effect: doc/benchmarks.md). Returns the capacity in doubles.
 std::size_t allocate_values(std::size_t doubles, std::unique_ptr<double[], CholmodSolver::FreeValues>& out) {
   constexpr std::size_t kHugePage = std::size_t{1} << 21;
   constexpr std::size_t kHugeFrom = std::size_t{8} << 20;

@@ -9,8 +9,8 @@
 // arguments as addF, about a fifth of the cost (doc/yade.md). Failing that (another
 // YADE, PFV built without Boost.Python), one addF call per body with a YADE Vector3 owned by the
 // bridge and written in place (half the cost of a tuple), or with tuples. The fallback's Python
-// objects (one Vector3 and one int per body, 60 ms at 10 000 bodies, all of it on the first step
-// of an engine) are made on its first use only: the direct call needs none of them.
+// objects (one Vector3 and one int per body, made on the first step of an engine) are made on its
+// first use only: the direct call needs none of them.
 #pragma once
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>

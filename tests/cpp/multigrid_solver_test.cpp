@@ -69,7 +69,8 @@ void expect_multigrid_matches_direct(const test::TestPacking& p, int steps) {
     // iterations; taking the last two ratios alone broke the promise at seed 5 (1.7 x).
     EXPECT_LE(worst, multigrid.settings.refinement_tolerance * s) << "step " << step;
     worst_ratio = std::max(worst_ratio, worst / (multigrid.settings.refinement_tolerance * s));
-    iterations += (step ? " " : "") + std::to_string(multigrid.last_solve().cg_iterations);
+    if (step > 0) iterations += ' ';
+    iterations += std::to_string(multigrid.last_solve().cg_iterations);
   }
   std::printf("%zu spheres: iterations per step %s; largest error %.2f x refinement_tolerance x spread\n",
               p.centre.size(), iterations.c_str(), worst_ratio);

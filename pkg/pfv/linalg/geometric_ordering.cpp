@@ -155,6 +155,7 @@ class Dissection {
     part_.assign(n, 0);
     side_.assign(n, 0);
     slot_.assign(n, -1);
+    sides_.assign(n, 0);
     level.assign(n, -1);
   }
 
@@ -170,7 +171,7 @@ class Dissection {
       todo.pop_back();
       if (p.end - p.begin <= leaf_size_) continue;
       const int id = part_[order_[p.begin]];
-      separate(p.begin, p.end, best_axis(p.begin, p.end, id), id);
+      separate(p.begin, p.end, best_axis(p.begin, p.end), id);
       max_depth = std::max(max_depth, p.depth);
       // Lower side, upper side, then the separator (the unknowns taken out of the part).
       const auto sep =
@@ -204,23 +205,44 @@ class Dissection {
   }
 
   // The axis whose median plane cuts the fewest edges of the part (the smallest cross-section).
-  int best_axis(int begin, int end, int id) {
-    const int mid = begin + (end - begin) / 2;
-    int best = 0;
-    long best_cut = -1;
+  // The three medians come from one gathered copy of the part's points, and one pass over the
+  // part's edges counts the crossings of all three planes, each unknown's sides packed in a byte
+  // (bit a: below the median along axis a; bit 3: in this part). The unknowns below a median
+  // are the same as the lower half of the selection separate() makes, unless coordinates tie.
+  int best_axis(int begin, int end) {
+    const int m = end - begin;
+    gathered_.resize(m);
+    for (int k = 0; k < m; ++k) gathered_[k] = point_[order_[begin + k]];
+    double median[3];
+    coordinate_.resize(m);
     for (int axis = 0; axis < 3; ++axis) {
-      select(begin, mid, end, axis);
-      for (int k = begin; k < end; ++k) side_[order_[k]] = k < mid ? 0 : 1;
-      long cut = 0;
-      for (int k = begin; k < mid; ++k) {
-        const int u = order_[k];
-        for (int e = g_.start[u]; e < g_.start[u + 1]; ++e) cut += part_[g_.next[e]] == id && side_[g_.next[e]] == 1;
-      }
-      if (best_cut < 0 || cut < best_cut) {
-        best_cut = cut;
-        best = axis;
+      for (int k = 0; k < m; ++k) coordinate_[k] = gathered_[k][axis];
+      std::nth_element(coordinate_.begin(), coordinate_.begin() + m / 2, coordinate_.end());
+      median[axis] = coordinate_[m / 2];
+    }
+    constexpr unsigned char kInPart = 8;
+    for (int k = 0; k < m; ++k) {
+      const auto& x = gathered_[k];
+      sides_[order_[begin + k]] =
+          static_cast<unsigned char>(kInPart | (x[0] < median[0]) | (x[1] < median[1]) << 1 | (x[2] < median[2]) << 2);
+    }
+    long cut[3] = {0, 0, 0};
+    for (int k = begin; k < end; ++k) {
+      const int u = order_[k];
+      const unsigned below = sides_[u] & 7u;
+      if (below == 0) continue;
+      for (int e = g_.start[u]; e < g_.start[u + 1]; ++e) {
+        const unsigned v = sides_[g_.next[e]];
+        const unsigned crossing = v & kInPart ? below & ~v & 7u : 0u;  // u below, v above the plane
+        cut[0] += crossing & 1u;
+        cut[1] += crossing >> 1 & 1u;
+        cut[2] += crossing >> 2;
       }
     }
+    for (int k = begin; k < end; ++k) sides_[order_[k]] = 0;
+    int best = 0;
+    for (int axis = 1; axis < 3; ++axis)
+      if (cut[axis] < cut[best]) best = axis;
     return best;
   }
 
@@ -292,6 +314,9 @@ class Dissection {
     int unknown;
   };
   std::vector<Keyed> keyed_;
+  std::vector<std::array<double, 3>> gathered_;
+  std::vector<double> coordinate_;
+  std::vector<unsigned char> sides_;  // best_axis: the sides of a part's unknowns, 0 elsewhere
   std::vector<int> order_, part_, slot_, band_;
   std::vector<char> side_;
   int parts_ = 0;

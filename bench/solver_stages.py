@@ -1,7 +1,7 @@
 """Stage measurements behind doc/benchmarks.md (stage measurements) and doc/solvers.md, on the cached benchmark
 packing (made by bench/flow_benchmark.py).
 
-    yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6,7]
+    yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6,7,8]
 
 1. ordering reuse: CHOLMOD analysis with a fresh METIS ordering and with the ordering carried over from the previous
    mesh, for the same positions and after moving every sphere at random by 0.5 % and 2 % of the mean radius
@@ -27,6 +27,10 @@ packing (made by bench/flow_benchmark.py).
    nested dissection (ordering="geometric") and CHOLMOD's rule (ordering="cholmod": AMD, then METIS if AMD fills
    badly, the better kept; what "auto" does below the threshold):
    analysis and factorisation times, nnz(L), the solve, and which ordering the rule keeps.
+8. first touch: writing a block the size of this packing's factor (8 bytes per entry of L) that the process has
+   never written (a fresh mapping, which the kernel zeroes page by page on the first write) against writing it
+   again, with transparent huge pages (numpy's madvise) and with 4 kB pages, three fresh blocks each, alternating and
+   all kept: the cost a first factorisation pays and a remesh, reusing its storage, does not.
 Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers;
 section 2 imitates the DEM's eviction of the factor).
 """
@@ -262,6 +266,34 @@ def ordering_threshold(pos, rad, L, repeats=3):
           % pfv.Engine.geometric_from)
 
 
+def first_touch(pos, rad, walls):
+    print('8. first touch of a block the size of the factor')
+    e = engine()
+    e.step(pos, rad, walls, 1e-4)
+    n = int(e.factor_nonzeros())
+    print('   %d entries of L: %.0f MB' % (n, 8e-6 * n))
+    huge = np.core.multiarray._set_madvise_hugepage(False)
+    rates = {False: [], True: []}
+    blocks = []  # all kept until the end: a freed block's pages would serve the next one already written
+    try:
+        for advise in (True, False) * 3:
+            np.core.multiarray._set_madvise_hugepage(advise)
+            block = np.empty(n)  # beyond glibc's mmap threshold: a mapping of its own, untouched
+            t0 = time.perf_counter()
+            block.fill(1.0)
+            t1 = time.perf_counter()
+            block.fill(2.0)
+            t2 = time.perf_counter()
+            rates[advise].append((8e-9 * n / (t1 - t0), 8e-9 * n / (t2 - t1)))
+            blocks.append(block)
+    finally:
+        np.core.multiarray._set_madvise_hugepage(huge)
+    for advise, pages in ((False, '4 kB pages'), (True, 'huge pages')):
+        r = rates[advise]
+        print('   %s: first write %s GB/s, second %s GB/s' % (
+            pages, ', '.join('%.2f' % x[0] for x in r), ', '.join('%.1f' % x[1] for x in r)))
+
+
 def main():
     n = option('size', 10000)
     spheres, meta = fb.read_packing(n)
@@ -270,7 +302,7 @@ def main():
     L = meta.get('box', fb.box_side(n))
     walls = [0, L, 0, L, 0, L]
     print('solver_stages: N = %d, packing %s' % (n, fb.packing_path(n)))
-    sections = option('sections', '1,2,3,4,5,6,7').split(',')
+    sections = option('sections', '1,2,3,4,5,6,7,8').split(',')
     if '1' in sections:
         ordering(pos, rad, walls)
     if '2' in sections:
@@ -281,6 +313,8 @@ def main():
         collective_limit(pos, rad, walls)
     if '7' in sections:
         ordering_threshold(pos, rad, L)
+    if '8' in sections:
+        first_touch(pos, rad, walls)
     if '5' in sections:
         remesh_sequence(n)
     return 0

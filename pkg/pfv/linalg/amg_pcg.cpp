@@ -224,7 +224,7 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
     throw std::invalid_argument("the multigrid solve needs one value of b and x per local row");
   std::copy(b.begin(), b.end(), m.b.begin());
   std::copy(x.begin(), x.end(), m.x.begin());
-  constexpr double kFirstIterationMargin = 1e-3, kSeedSafety = 2;
+  constexpr double kNegligibleUpdate = 1e-3, kSeedSafety = 2;
   double previous = 0, largest = 0;
   const auto stop = [&](int k, double alpha) {
     double d = 0, lo = m.x.data[0], hi = m.x.data[0], size = 0;
@@ -240,15 +240,18 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
     d = global[0];
     const double spread = global[1] + global[2] > 0 ? global[1] + global[2] : global[3];
     const double bound = tolerance * spread;
-    if (d == 0) return true;
+    if (d <= kNegligibleUpdate * bound) return true;
     if (k == 1) {
       previous = d;
       const double seed = kSeedSafety * seen_ratio_;
-      return d <= kFirstIterationMargin * bound || (seed > 0 && seed < 1 && seed / (1 - seed) * d <= bound);
+      return seed > 0 && seed < 1 && seed / (1 - seed) * d <= bound;
     }
-    largest = std::max(largest, d / previous);
+    const double ratio = d / previous;
     previous = d;
-    return largest < 1 && largest / (1 - largest) * d <= bound;
+    // An update larger than the one before: the iteration is not contracting (yet), so the
+    // ratios so far say nothing about the error; the estimate starts again from the next one.
+    largest = ratio < 1 ? std::max(largest, ratio) : 0;
+    return largest > 0 && largest / (1 - largest) * d <= bound;
   };
   AmgSolveStats stats;
   const int k = m.iterate(max_iterations, stop);

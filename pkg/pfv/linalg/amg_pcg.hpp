@@ -10,10 +10,12 @@
 // tolerance * spread, rho the largest ratio of successive update norms in this solve. The
 // ratios of CG's updates swing by a factor of two from one iteration to the next, so the last
 // two alone can promise a contraction the iteration does not keep: with them, pressures came
-// out up to 1.7 times the bound from the direct solve's (multigrid_solver_test.cpp). The
-// first iteration has no ratio of its own: it takes twice the largest ratio of the last solve
-// that made two or more (as the refinement seeds its contraction), and without one stops only
-// if its update is already 1e-3 of the bound. Between remeshes, once the start is extrapolated
+// out up to 1.7 times the bound from the direct solve's (multigrid_solver_test.cpp). An update
+// larger than the one before restarts the estimate (CG's updates need not shrink every time;
+// a weak preconditioner makes them swing past 1), and one below 1e-3 of the bound stops the
+// solve whatever the ratios (at the rounding floor they are noise). The first iteration has no
+// ratio of its own: it takes twice the largest ratio of the last solve that made two or more
+// (as the refinement seeds its contraction). Between remeshes, once the start is extrapolated
 // from a smooth history, one iteration (one V-cycle, two products with G) is then the common
 // case.
 //

@@ -155,7 +155,7 @@ class Dissection {
     part_.assign(n, 0);
     side_.assign(n, 0);
     slot_.assign(n, -1);
-    sides_.assign(n, 0);
+    median_sides_.assign(n, 0);
     level.assign(n, -1);
   }
 
@@ -223,23 +223,23 @@ class Dissection {
     constexpr unsigned char kInPart = 8;
     for (int k = 0; k < m; ++k) {
       const auto& x = gathered_[k];
-      sides_[order_[begin + k]] =
+      median_sides_[order_[begin + k]] =
           static_cast<unsigned char>(kInPart | (x[0] < median[0]) | (x[1] < median[1]) << 1 | (x[2] < median[2]) << 2);
     }
     long cut[3] = {0, 0, 0};
     for (int k = begin; k < end; ++k) {
       const int u = order_[k];
-      const unsigned below = sides_[u] & 7u;
+      const unsigned below = median_sides_[u] & 7u;
       if (below == 0) continue;
       for (int e = g_.start[u]; e < g_.start[u + 1]; ++e) {
-        const unsigned v = sides_[g_.next[e]];
+        const unsigned v = median_sides_[g_.next[e]];
         const unsigned crossing = v & kInPart ? below & ~v & 7u : 0u;  // u below, v above the plane
         cut[0] += crossing & 1u;
         cut[1] += crossing >> 1 & 1u;
         cut[2] += crossing >> 2;
       }
     }
-    for (int k = begin; k < end; ++k) sides_[order_[k]] = 0;
+    for (int k = begin; k < end; ++k) median_sides_[order_[k]] = 0;
     int best = 0;
     for (int axis = 1; axis < 3; ++axis)
       if (cut[axis] < cut[best]) best = axis;
@@ -316,7 +316,7 @@ class Dissection {
   std::vector<Keyed> keyed_;
   std::vector<std::array<double, 3>> gathered_;
   std::vector<double> coordinate_;
-  std::vector<unsigned char> sides_;  // best_axis: the sides of a part's unknowns, 0 elsewhere
+  std::vector<unsigned char> median_sides_;  // best_axis: the sides of a part's unknowns, 0 elsewhere
   std::vector<int> order_, part_, slot_, band_;
   std::vector<char> side_;
   int parts_ = 0;

@@ -134,7 +134,8 @@ TEST(Multigrid, StopsWithinTheBoundWhenUpdatesGrow) {
   weak.relax_type = 0;  // Jacobi, on every level and in both directions
   weak.relax_down = weak.relax_up = -1;
   weak.strong_threshold = 0.9;
-  const double tolerance = 1e-10, limit = 2000;
+  const double tolerance = 1e-10;
+  const int limit = 2000;
   const AmgSolveStats stats = AmgPcg(MPI_COMM_SELF, rows, weak).solve(b, x, tolerance, limit);
   ASSERT_TRUE(stats.converged) << stats.iterations << " iterations";
   EXPECT_LT(stats.iterations, limit);

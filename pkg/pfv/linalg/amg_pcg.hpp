@@ -8,7 +8,7 @@
 // 32-bit factor is (refinement.hpp), and hypre's Krylov solvers stop on residual norms only.
 // A solve stops once the estimated error rho / (1 - rho) * max |update| is below
 // tolerance * spread, rho the largest ratio of successive update norms in this solve. The
-// ratios of CG's updates swing by a factor of two from one iteration to the next, so the last
+// ratios of CG's updates swing from one iteration to the next, so the last
 // two alone can promise a contraction the iteration does not keep: with them, pressures came
 // out up to 1.7 times the bound from the direct solve's (multigrid_solver_test.cpp). An update
 // larger than the one before restarts the estimate (CG's updates need not shrink every time;

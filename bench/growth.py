@@ -135,7 +135,11 @@ def trial(kind, steady):
     flow = make_flow(kind)
     insert(flow)
     first = [timed_step() for _ in range(WINDOW)]
-    steps = [timed_step() for _ in range(steady)]
+    steps, per_step = [], []
+    for _ in range(steady):
+        steps.append(timed_step())
+        if kind != "yade":  # what the core did in that step, to tell solver time from the rest of the step
+            per_step.append(dict(flow.core.step_times(), cg_iterations=flow.core.cg_iterations))
     steady_iterations = flow.core.cg_iterations if kind != "yade" else None
     flow.updateTriangulation = True
     remesh = [timed_step() for _ in range(WINDOW)]
@@ -144,6 +148,7 @@ def trial(kind, steady):
         rec["solver_choice"] = flow.core.solver_choice
         rec["cg_iterations"] = flow.core.cg_iterations  # the last step of the remesh window
         rec["steady_cg_iterations"] = steady_iterations
+        rec["steady_core"] = per_step  # per steady step: the core's stage times and iterations (JSON only)
         rec["remesh_times"] = dict(flow.core.remesh_times())  # the forced remesh's stages (JSON only)
     del flow
     remove_flows()

@@ -6,9 +6,9 @@ The 1000-sphere permeameter, pressure 1 on ymin, 0 on ymax, spheres free to move
   * the default is solver='auto', which picks CHOLMOD here and says so in core.solver_choice;
     useSolver reads 3 for it;
   * solver='multigrid' gives the fluxes and forces of CHOLMOD at every one of 20 DEM steps
-    across a remesh (fluxes to 1e-8, conserved to 1e-8);
+    across a remesh (fluxes to 1e-8, conserved to 1e-8), with either multigrid_smoother;
   * max_factor_bytes below this factor makes 'auto' choose multigrid and report why;
-  * an unknown solver name and a negative max_factor_bytes raise ValueError naming the setting,
+  * an unknown solver or smoother name and a negative max_factor_bytes raise ValueError naming the setting,
     and the engine still runs afterwards.
 """
 import os
@@ -46,6 +46,13 @@ rb.check("multigrid force on a sphere equals CHOLMOD's at every step (1e-7)", wo
 worst_m = max(abs(imbalance) / scale for _, _, (_, (scale, imbalance)) in multigrid)
 rb.check("multigrid conserves mass at every step (1e-8 of the largest wall flux)", all(m[2][0] for m in multigrid),
          f"worst {worst_m:.2e}")
+flow, gauss_seidel = history(solver="multigrid", multigrid_smoother="gauss_seidel")
+rb.check("multigrid_smoother='gauss_seidel' is set", flow.multigrid_smoother == "gauss_seidel")
+worst_q = max(abs(a[0] / b[0] - 1) for a, b in zip(gauss_seidel, direct))
+worst_m = max(abs(imbalance) / scale for _, _, (_, (scale, imbalance)) in gauss_seidel)
+rb.check("with Gauss-Seidel smoothing too: outflux equals CHOLMOD's (1e-8)", worst_q < 1e-8, f"worst {worst_q:.2e}")
+rb.check("with Gauss-Seidel smoothing too: mass conserved (1e-8)", all(m[2][0] for m in gauss_seidel),
+         f"worst {worst_m:.2e}")
 
 O.reset()
 flow = rb.fresh()
@@ -68,7 +75,10 @@ rb.run(1)
 rb.expect_error("unknown solver name", ValueError, "solver must be one of", lambda: setattr(flow, "solver", "amg"))
 rb.expect_error("negative max_factor_bytes", ValueError, "max_factor_bytes",
                 lambda: setattr(flow, "max_factor_bytes", -1.0))
-rb.check("the solver is unchanged after the refused settings", flow.solver == "auto")
+rb.expect_error("unknown multigrid smoother", ValueError, "multigrid_smoother must be one of",
+                lambda: setattr(flow, "multigrid_smoother", "sor"))
+rb.check("the solver is unchanged after the refused settings",
+         flow.solver == "auto" and flow.multigrid_smoother == "jacobi")
 rb.run(1)
 rb.check("the engine still runs after the refused settings", abs(flow.getBoundaryFlux(3) / q - 1) < 1e-8,
          f"{flow.getBoundaryFlux(3):.6e} vs {q:.6e}")

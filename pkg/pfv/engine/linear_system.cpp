@@ -117,6 +117,7 @@ SystemRecipe::SystemRecipe(const EngineSettings& s, const BoundaryConditions& bc
       mixed_precision(s.mixed_precision),
       mixed_precision_min_entries(s.mixed_precision_min_entries),
       max_factor_bytes(s.max_factor_bytes),
+      multigrid_smoother(s.multigrid_smoother),
       fluid_bulk_modulus(s.fluid_bulk_modulus),
       minimum_porosity(s.minimum_porosity),
       dt(step),
@@ -135,6 +136,9 @@ bool SystemRecipe::stale_for(const EngineSettings& s, const BoundaryConditions& 
                  mixed_precision_min_entries != s.mixed_precision_min_entries))
     return true;
   if (solver == SolverKind::kAuto && max_factor_bytes != s.max_factor_bytes) return true;
+  // Under kAuto also while it keeps the factor: the recipe does not know the choice.
+  if ((solver == SolverKind::kMultigrid || solver == SolverKind::kAuto) && multigrid_smoother != s.multigrid_smoother)
+    return true;
   if (imposed_pressure_at.size() != bc.imposed_pressure.size() || imposed_flux_at.size() != bc.imposed_flux.size() ||
       !(profile == bc.profile))
     return true;
@@ -246,7 +250,9 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       pcg->setup(s);
     } else if (auto* amg = dynamic_cast<AmgSolver*>(l.solver.get())) {
       if (automatic && l.choice.empty()) l.choice = "multigrid: kept from the previous mesh";
-      amg->setup(s);
+      AmgParameters parameters;
+      if (settings.multigrid_smoother == MultigridSmoother::kGaussSeidel) parameters.relax_type = 8;
+      amg->setup(s, parameters);
     }
   }
   l.times.factorization = seconds_since(t0) - l.times.analysis;

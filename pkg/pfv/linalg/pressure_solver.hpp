@@ -18,6 +18,10 @@ struct PressureSystem;
 
 enum class SolverKind { kGaussSeidel, kConjugateGradient, kCholesky, kMultigrid, kAuto };
 
+// The smoother of the multigrid V-cycle (amg_pcg.hpp: hypre's l1-scaled Jacobi, or its
+// symmetric l1-Gauss-Seidel sweeps).
+enum class MultigridSmoother { kJacobi, kGaussSeidel };
+
 std::string_view to_string(SolverKind kind);
 
 // Stopping rules; each solver reads the ones that concern it.

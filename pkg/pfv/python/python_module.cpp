@@ -202,6 +202,19 @@ PYBIND11_MODULE(_core, m) {
       .def_property("max_factor_bytes", get_setting(&EngineSettings::max_factor_bytes),
                     set_setting(&EngineSettings::max_factor_bytes),
                     "The largest Cholesky factor solver='auto' accepts (0: half the available memory).")
+      .def_property(
+          "multigrid_smoother", exclusive([](const SharedEngine& e) {
+            return std::string(e.settings.multigrid_smoother == MultigridSmoother::kJacobi ? "jacobi" : "gauss_seidel");
+          }),
+          exclusive([](SharedEngine& e, const std::string& v) {
+            if (v != "jacobi" && v != "gauss_seidel")
+              throw py::value_error("multigrid_smoother must be one of jacobi, gauss_seidel; got '" + v + "'");
+            update(e, [&](EngineSettings& s) {
+              s.multigrid_smoother = v == "jacobi" ? MultigridSmoother::kJacobi : MultigridSmoother::kGaussSeidel;
+            });
+          }),
+          "The multigrid V-cycle's smoother: jacobi (default; l1-scaled) or gauss_seidel (symmetric l1-scaled "
+          "sweeps); rebuilds the hierarchy at the next step.")
       .def_property_readonly("solver_choice", exclusive([](const SharedEngine& e) { return e.solver_choice(); }),
                              "The current system's solver and why; empty before the first step.")
       .def_property("tolerance", get_setting(&EngineSettings::tolerance), set_setting(&EngineSettings::tolerance))

@@ -50,6 +50,7 @@ CORE_NAME: dict[str, str] = {
     "yade_wall_throat_factor": "yade_wall_throat_factor",
     "solver": "solver",
     "max_factor_bytes": "max_factor_bytes",
+    "multigrid_smoother": "multigrid_smoother",
     "shear_viscosity": "shear_viscosity",
 }
 

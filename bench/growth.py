@@ -15,10 +15,12 @@ Every measurement is a fresh `yade-double -j1` child (OMP_NUM_THREADS=1), so tha
 against another's:
   timing child, one per N: the scene is built once; the engines at this N take turns on it (inserted before the
     NewtonIntegrator, removed after their trial), then the dry DEM. A trial: W = 3 first steps, S steady steps, a
-    forced remesh (updateTriangulation=True) and W steps. first step = wall time of the first O.step() minus the dry
-    step; flow step = median steady O.step() minus the dry step; remesh = the W steps from the forced remesh minus
-    (W - 1) steady steps, minus one dry step (YADE remeshes at the end of a step and factorises at the next: the
-    window covers both).
+    forced remesh (updateTriangulation=True) and W steps; each steady step is followed by a dry step (the engine
+    taken out of O.engines for it), so that the two see the machine alike. first step = wall time of the first
+    O.step() minus the dry step (median of the trial's); flow step = median steady O.step() minus the dry step;
+    remesh = the W steps from the forced remesh minus (W - 1) steady steps, minus one dry step (YADE remeshes at the
+    end of a step and factorises at the next: the window covers both). The dry steps after the trials are kept in
+    the JSON (older children recorded only those).
   memory child, one per N and engine: peak RSS = VmHWM (reset through /proc/self/clear_refs once the scene is
     built) minus VmRSS before the engine is added, over a first step, S steps and a forced remesh.
 YADE runs at --sizes only; --pfv-sizes are PFV alone (YADE's factor at those sizes does not fit this machine), both
@@ -135,15 +137,20 @@ def trial(kind, steady):
     flow = make_flow(kind)
     insert(flow)
     first = [timed_step() for _ in range(WINDOW)]
-    steps, per_step = [], []
+    steps, per_step, dry = [], [], []
     for _ in range(steady):
         steps.append(timed_step())
         if kind != "yade":  # what the core did in that step, to tell solver time from the rest of the step
             per_step.append(dict(flow.core.step_times(), cg_iterations=flow.core.cg_iterations))
+        # A dry step right after each coupled one, so that a drift of the machine's speed during the
+        # child moves both alike (the spheres are fixed: the engine misses nothing).
+        remove_flows()
+        dry.append(timed_step())
+        insert(flow)
     steady_iterations = flow.core.cg_iterations if kind != "yade" else None
     flow.updateTriangulation = True
     remesh = [timed_step() for _ in range(WINDOW)]
-    rec = dict(first=first, steady=steps, remesh=remesh)
+    rec = dict(first=first, steady=steps, remesh=remesh, dry=dry)
     if kind != "yade":
         rec["solver_choice"] = flow.core.solver_choice
         rec["cg_iterations"] = flow.core.cg_iterations  # the last step of the remesh window
@@ -204,8 +211,8 @@ def summarise(timing, memory):
     for t in timing:
         if t.get("failed"):
             continue
-        dry = statistics.median(t["dry"])
         for kind, tr in t["trials"].items():
+            dry = statistics.median(tr.get("dry") or t["dry"])  # the trial's own dry steps where recorded
             flow = statistics.median(tr["steady"]) - dry
             coupled = flow + dry
             remesh = sum(tr["remesh"]) - (WINDOW - 1) * coupled - dry

@@ -109,6 +109,9 @@ def make_flow(kind):
         flow.useSolver = 3
     elif kind == "pfv-multigrid":
         flow.solver = "multigrid"
+    elif kind == "pfv-multigrid-jacobi":  # not in the default plan: --child=time --kinds=pfv-multigrid-jacobi
+        flow.solver = "multigrid"
+        flow.multigrid_smoother = "jacobi"
     return flow
 
 

@@ -3,7 +3,7 @@
 // MPI_COMM_WORLD, each owning a contiguous block of rows:
 //
 //     mpirun -np P build/pfv_amg_solve FOLDER [--tolerance=1e-10] [--out=FILE] [--repeat=0]
-//         [--strong=0.5] [--coarsen=10] [--interp=6] [--pmax=4] [--relax=18] [--relax-down=R] [--relax-up=R]
+//         [--strong=0.5] [--coarsen=10] [--interp=6] [--pmax=4] [--relax=8] [--relax-down=R] [--relax-up=R]
 //         [--aggressive=0] [--print=0]
 //
 // The solve starts from zero and stops by the engine's rule (estimated error below tolerance

@@ -55,7 +55,7 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
       {"mixed_precision", [](FlowEngine& e) { e.settings.mixed_precision = false; }},
       {"mixed_precision_min_entries", [](FlowEngine& e) { e.settings.mixed_precision_min_entries = 0; }},
       {"max_factor_bytes", [](FlowEngine& e) { e.settings.max_factor_bytes = 1e4; }},
-      {"multigrid_smoother", [](FlowEngine& e) { e.settings.multigrid_smoother = MultigridSmoother::kGaussSeidel; }},
+      {"multigrid_smoother", [](FlowEngine& e) { e.settings.multigrid_smoother = MultigridSmoother::kJacobi; }},
       {"fluid_bulk_modulus", [](FlowEngine& e) { e.settings.fluid_bulk_modulus = 1e5; }},
       {"bnd_is_pressure", [](FlowEngine& e) { e.bc.is_pressure = {true, true, true, false, false, false}; }},
       {"impose_pressure",

@@ -24,10 +24,10 @@ struct EngineSettings {
   // double); 0: half the memory available (MemAvailable) when the system is built, plus the
   // storage of the factor it replaces.
   double max_factor_bytes = 0;
-  // Multigrid (named or chosen by kAuto): the V-cycle's smoother. Jacobi costs less per step from
-  // an exact or a perturbed start; Gauss-Seidel less where it certifies a step after one
-  // iteration and Jacobi needs two (doc/solvers.md). A change rebuilds the hierarchy.
-  MultigridSmoother multigrid_smoother = MultigridSmoother::kJacobi;
+  // Multigrid (named or chosen by kAuto): the V-cycle's smoother. Jacobi costs less per step
+  // where the start stays exact for many steps (a fixed skeleton), Gauss-Seidel where it is
+  // close but not exact (doc/solvers.md). A change rebuilds the hierarchy.
+  MultigridSmoother multigrid_smoother = MultigridSmoother::kGaussSeidel;
   double tolerance = 1e-6;  // Gauss-Seidel, incomplete-Cholesky CG
   double relax = 1.9;       // Gauss-Seidel
   int max_iterations = 200000;

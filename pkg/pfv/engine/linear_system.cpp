@@ -251,7 +251,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
     } else if (auto* amg = dynamic_cast<AmgSolver*>(l.solver.get())) {
       if (automatic && l.choice.empty()) l.choice = "multigrid: kept from the previous mesh";
       AmgParameters parameters;
-      if (settings.multigrid_smoother == MultigridSmoother::kGaussSeidel) parameters.relax_type = 8;
+      if (settings.multigrid_smoother == MultigridSmoother::kJacobi) parameters.relax_type = 18;
       amg->setup(s, parameters);
     }
   }

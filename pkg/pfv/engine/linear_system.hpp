@@ -29,8 +29,8 @@ struct SystemRecipe {
   Ordering ordering = Ordering::kAuto;  // Cholesky only
   bool mixed_precision = false;         // Cholesky only
   double mixed_precision_min_entries = 0;
-  double max_factor_bytes = 0;                                        // kAuto only
-  MultigridSmoother multigrid_smoother = MultigridSmoother::kJacobi;  // kMultigrid, kAuto
+  double max_factor_bytes = 0;                                             // kAuto only
+  MultigridSmoother multigrid_smoother = MultigridSmoother::kGaussSeidel;  // kMultigrid, kAuto
   double fluid_bulk_modulus = 0;
   double minimum_porosity = 0;  // enters G only with a compressible fluid
   double dt = 0;                // likewise

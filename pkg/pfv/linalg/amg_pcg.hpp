@@ -47,19 +47,17 @@ struct DistributedRows {
 // a strength threshold of 0.5 in 3D), with a symmetric smoother so that the V-cycle is a
 // symmetric preconditioner for CG.
 //
-// The smoother is l1-scaled Jacobi rather than the symmetric l1-Gauss-Seidel sweeps
-// (relax_type 8): its iteration reads each level's matrix half as often, a solve needs more
-// iterations, and what a step costs then depends on where its start lies: the same or less from
-// a perturbed start or an exact one, more where Gauss-Seidel certifies after one iteration and
-// Jacobi needs two (the measurements in doc/solvers.md). The smoothing does not change with the
-// thread count, where hypre's Gauss-Seidel runs Gauss-Seidel within each thread's rows and
-// Jacobi between them.
+// The smoother is the symmetric l1-Gauss-Seidel sweep pair (relax_type 8); l1-scaled Jacobi
+// (18) reads each level's matrix half as often per iteration but needs more iterations, and
+// its slower contraction makes the stopping rule's first-iteration test more cautious: it costs
+// less per step where the start is exact for many steps (a fixed skeleton), more where the
+// start is close but not exact (doc/solvers.md, bench/multigrid_smoothers.py).
 struct AmgParameters {
   double strong_threshold = 0.5;
   int coarsen_type = 10;  // HMIS
   int interp_type = 6;    // extended+i
   int max_row_entries = 4;
-  int relax_type = 18;  // l1-scaled Jacobi, where relax_down, relax_up are -1 (8: symmetric l1-Gauss-Seidel)
+  int relax_type = 8;  // symmetric l1-Gauss-Seidel, where relax_down, relax_up are -1 (18: l1-scaled Jacobi)
   // The smoothers on the way down and up the V-cycle, e.g. l1-scaled hybrid Gauss-Seidel forwards
   // down (13), backwards up (14): the cycle stays symmetric, as CG needs, with one sweep per level
   // and direction where the symmetric Gauss-Seidel makes two (bench/amg/amg_solve.cpp).

@@ -18,9 +18,9 @@ struct PressureSystem;
 
 enum class SolverKind { kGaussSeidel, kConjugateGradient, kCholesky, kMultigrid, kAuto };
 
-// The smoother of the multigrid V-cycle (amg_pcg.hpp: hypre's l1-scaled Jacobi, or its
-// symmetric l1-Gauss-Seidel sweeps).
-enum class MultigridSmoother { kJacobi, kGaussSeidel };
+// The smoother of the multigrid V-cycle (amg_pcg.hpp: hypre's symmetric l1-Gauss-Seidel sweeps,
+// or its l1-scaled Jacobi).
+enum class MultigridSmoother { kGaussSeidel, kJacobi };
 
 std::string_view to_string(SolverKind kind);
 

@@ -213,8 +213,8 @@ PYBIND11_MODULE(_core, m) {
               s.multigrid_smoother = v == "jacobi" ? MultigridSmoother::kJacobi : MultigridSmoother::kGaussSeidel;
             });
           }),
-          "The multigrid V-cycle's smoother: jacobi (default; l1-scaled) or gauss_seidel (symmetric l1-scaled "
-          "sweeps); rebuilds the hierarchy at the next step.")
+          "The multigrid V-cycle's smoother: gauss_seidel (default; symmetric l1-scaled sweeps) or jacobi "
+          "(l1-scaled; cheaper for a fixed skeleton); rebuilds the hierarchy at the next step.")
       .def_property_readonly("solver_choice", exclusive([](const SharedEngine& e) { return e.solver_choice(); }),
                              "The current system's solver and why; empty before the first step.")
       .def_property("tolerance", get_setting(&EngineSettings::tolerance), set_setting(&EngineSettings::tolerance))

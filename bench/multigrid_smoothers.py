@@ -7,7 +7,8 @@ One pfv.Engine (no YADE) on bench/growth.py's jittered lattice, multigrid, perme
 runs both smoothers, the order alternating from round to round; a smoother's turn sets multigrid_smoother (which
 rebuilds the hierarchy on the same mesh), then times three phases from the packing's rest positions:
 
-* static: the spheres still, so each solve starts from the exact pressures (one iteration certifies it);
+* static: the spheres still, so each solve starts from the pressures of the last step, which tend to the exact ones
+  (one iteration certifies them once the error left by the last multi-iteration solve has been worked off);
 * squeeze: every sphere moved towards the mid-plane y by a strain of 2e-5 per step, a smooth motion whose pressures
   the start extrapolated from the last two steps nearly predicts;
 * jerky squeeze: a strain of 1e-11 k^3 after k steps, whose changing acceleration the linear extrapolation misses
@@ -35,7 +36,7 @@ import pfv  # noqa: E402
 
 SMOOTHERS = ("jacobi", "gauss_seidel")
 # name, strain of the squeeze after k steps, random displacement per step in radii, steps
-PHASES = (("static", lambda k: 0.0, 0.0, 5), ("squeeze", lambda k: 2e-5 * k, 0.0, 6),
+PHASES = (("static", lambda k: 0.0, 0.0, 10), ("squeeze", lambda k: 2e-5 * k, 0.0, 6),
           ("jerky squeeze", lambda k: 1e-11 * k ** 3, 0.0, 6),
           ("random motion", lambda k: 0.0, 1e-4, 6))
 DT = 1e-4

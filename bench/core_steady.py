@@ -22,7 +22,9 @@ import pfv  # noqa: E402
 KEYS = ('volumes', 'solve', 'forces', 'total')
 
 
-def measure(n, steady=5):
+def lattice_permeameter(n):
+    """The engine (not yet stepped), centres, radii and walls of the scene above; shared with
+    bench/multigrid_smoothers.py."""
     pos, rad = jittered_lattice(n)
     lo, hi = (pos - rad[:, None]).min(0), (pos + rad[:, None]).max(0)
     walls = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
@@ -32,6 +34,11 @@ def measure(n, steady=5):
     e.viscosity = 1e-3
     e.mesh_update_interval = 10 ** 9
     e.solver = 'multigrid'
+    return e, pos, rad, walls
+
+
+def measure(n, steady=5):
+    e, pos, rad, walls = lattice_permeameter(n)
     t0 = time.perf_counter()
     e.step(pos, rad, walls, 1e-4)
     first = time.perf_counter() - t0

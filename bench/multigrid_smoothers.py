@@ -3,9 +3,10 @@
     OMP_NUM_THREADS=1 PYTHONPATH=build/python /usr/bin/python3 bench/multigrid_smoothers.py [N] [--rounds=3]
         (default N = 200000)
 
-One pfv.Engine (no YADE) on bench/growth.py's jittered lattice, multigrid, permeameter along y, no remesh. Each round
-runs both smoothers, the order alternating from round to round; a smoother's turn sets multigrid_smoother (which
-rebuilds the hierarchy on the same mesh), then times three phases from the packing's rest positions:
+One pfv.Engine (no YADE) on bench/core_steady.py's scene (the jittered lattice, multigrid, permeameter along y).
+Each round runs both smoothers, the order alternating from round to round; a smoother's turn sets
+multigrid_smoother (which rebuilds the hierarchy on the same mesh), then times four phases from the packing's rest
+positions:
 
 * static: the spheres still, so each solve starts from the pressures of the last step, which tend to the exact ones
   (one iteration certifies them once the error left by the last multi-iteration solve has been worked off);
@@ -30,9 +31,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from lattice import jittered_lattice  # noqa: E402
-
-import pfv  # noqa: E402
+from core_steady import lattice_permeameter  # noqa: E402
 
 SMOOTHERS = ("jacobi", "gauss_seidel")
 # name, strain of the squeeze after k steps, random displacement per step in radii, steps
@@ -74,15 +73,7 @@ def main(argv):
     sizes = [int(float(a)) for a in argv if not a.startswith("--")] or [200000]
     rounds = next((int(a.split("=")[1]) for a in argv if a.startswith("--rounds=")), 3)
     for n in sizes:
-        pos, rad = jittered_lattice(n)
-        lo, hi = (pos - rad[:, None]).min(0), (pos + rad[:, None]).max(0)
-        walls = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
-        e = pfv.Engine()
-        e.bnd_is_pressure = [False, False, True, True, False, False]
-        e.bnd_value = [0, 0, 100.0, 0, 0, 0]
-        e.viscosity = 1e-3
-        e.mesh_update_interval = 10 ** 9
-        e.solver = "multigrid"
+        e, pos, rad, walls = lattice_permeameter(n)
         e.step(pos, rad, walls, DT)
         results = {s: [] for s in SMOOTHERS}
         for r in range(rounds):

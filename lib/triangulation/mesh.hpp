@@ -2,7 +2,9 @@
 //
 // Vertices 0..n_spheres-1 are the spheres in input order; vertex n_spheres + w is wall w.
 // Only "pore" cells are kept: finite cells with at least one sphere vertex and no two
-// walls facing each other. Neighbour -1 means no pore cell across that facet.
+// walls facing each other. Neighbour -1 means no pore cell across that facet. Cells are
+// numbered breadth-first over their adjacency, so that neighbouring cells have near numbers
+// (regular_triangulation.cpp).
 #pragma once
 #include <array>
 #include <vector>

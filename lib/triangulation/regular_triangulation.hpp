@@ -35,8 +35,8 @@ class RegularTriangulation {
 
   // locate() of every point, each walk started from the cell of the previous point found. CGAL's
   // walk from an arbitrary cell crosses O(N^(1/3)) cells; points listed in a spatially coherent
-  // order (the cells of another mesh of the same packing, by index: CGAL numbers them in the
-  // order its spatially sorted insertion made them) are found a few cells from the last one.
+  // order (the cells of another mesh of the same packing, by index: they are numbered
+  // breadth-first, mesh.hpp) are found a few cells from the last one.
   std::vector<int> locate_all(const std::vector<Vec3>& points) const;
 
   // Pairs of spheres with one centre inside the other sphere: neighbours in the

@@ -54,6 +54,10 @@ with tempfile.TemporaryDirectory(prefix="pfv-growth-") as work:
             numbers = [float(c) for c in (cells[2], cells[3], cells[5], cells[7])]  # first, remesh, dry, peak
             check(f"N={n} {kind}: positive first step, remesh, dry step and peak RSS", all(map(positive, numbers)),
                   str(cells))
+            ratio, spread = cells[6].split(" ", 1)
+            low, high = (float(x) for x in spread.strip("()").split("\u2013"))
+            check(f"N={n} {kind}: coupled / dry, the median of the blocks, within their range",
+                  0 < low <= float(ratio) <= high, cells[6])
             if kind == "pfv":
                 check(f"N={n} pfv: auto chose CHOLMOD", cells[8].startswith("cholesky"), cells[8])
             if kind == "pfv-multigrid":

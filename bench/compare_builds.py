@@ -1,11 +1,17 @@
-"""Two builds of pfv side by side on the benchmark permeameter (the cached dense packing of
-bench/flow_benchmark.py, dynamic spheres, CHOLMOD, settled): the steady flow step and a forced
-remesh, measured as the engine's execTime in the DEM loop. For a change that must not alter
-speed (a refactoring), run the build before and the build after; the children alternate
-between the builds round after round, so that drift of the machine falls on both.
+"""Two builds of pfv side by side: the steady flow step and a forced remesh. For a change that
+must not alter speed (a refactoring), or one meant to change it, run the build before and the
+build after; the children alternate between the builds round after round, so that drift of the
+machine falls on both.
 
     python3 bench/compare_builds.py --builds=OLD_PYTHONPATH,NEW_PYTHONPATH [--size=10000] [--rounds=3]
                                     [--steady=20] [--remeshes=2] [--threads=1]
+                                    [--scene=permeameter|lattice] [--solver=auto]
+
+--scene=permeameter (default): the benchmark permeameter in YADE (the cached dense packing of
+bench/flow_benchmark.py, dynamic spheres, CHOLMOD, settled), times as the engine's execTime in
+the DEM loop. --scene=lattice: the C++ engine alone (pfv.Engine, no YADE) on bench/growth.py's
+jittered lattice with fixed spheres (bench/core_steady.py), with --solver (auto, cholesky,
+multigrid); times are the step's wall time, and the solve's is reported beside it.
 
 Each PYTHONPATH holds a `pfv` package (e.g. build/python). Prints per build the median over
 rounds of the per-round medians, and the ratio of the second build to the first. No timing is
@@ -25,8 +31,39 @@ def option(argv, name, default):
     return default
 
 
+def lattice_child(argv):
+    import time
+    from core_steady import lattice_permeameter
+
+    e, pos, rad, walls = lattice_permeameter(int(float(option(argv, "size", "10000"))))
+    e.solver = option(argv, "solver", "auto")
+
+    def timed_step():
+        t0 = time.perf_counter()
+        e.step(pos, rad, walls, 1e-4)
+        return time.perf_counter() - t0
+
+    for _ in range(4):  # the first step and three settling steps
+        timed_step()
+    steady, solve = [], []
+    for _ in range(int(option(argv, "steady", "20"))):
+        steady.append(timed_step())
+        solve.append(e.step_times()["solve"])
+    remesh = []
+    for _ in range(int(option(argv, "remeshes", "2"))):
+        e.request_remesh()
+        remesh.append(timed_step())
+        for _ in range(2):
+            timed_step()
+    print("RESULT " + json.dumps(dict(steady=statistics.median(steady), solve=statistics.median(solve),
+                                      remesh=statistics.median(remesh), cells=e.n_cells(),
+                                      package=__import__("pfv").__file__)))
+
+
 def child(argv):
     sys.path.insert(0, os.path.dirname(os.path.abspath(argv[0])))
+    if option(argv, "scene", "permeameter") == "lattice":
+        return lattice_child(argv)
     import flow_benchmark as fb
     from yade import O
 
@@ -63,25 +100,32 @@ def driver(argv):
     rounds = int(option(argv, "rounds", "3"))
     threads = option(argv, "threads", "1")
     passed = [a for a in argv if not a.startswith(("--builds=", "--rounds=", "--threads="))]
+    if option(argv, "scene", "permeameter") == "lattice":
+        launcher = ["/usr/bin/python3"]
+    else:
+        launcher = ["yade-double", "-j" + threads, "-n", "-x"]
     results = {b: [] for b in builds}
     for r in range(rounds):
         for b in (builds if r % 2 == 0 else builds[::-1]):
             env = dict(os.environ, PYTHONPATH=b, OMP_NUM_THREADS=threads, OPENBLAS_NUM_THREADS=threads)
-            out = subprocess.run(["yade-double", "-j" + threads, "-n", "-x", os.path.abspath(__file__), "--child"]
-                                 + passed, env=env, capture_output=True, text=True)
+            out = subprocess.run(launcher + [os.path.abspath(__file__), "--child"] + passed, env=env,
+                                 capture_output=True, text=True)
             line = [x for x in out.stdout.splitlines() if x.startswith("RESULT ")]
             if out.returncode != 0 or not line:
                 sys.exit(f"child failed for {b}:\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}")
             res = json.loads(line[-1][len("RESULT "):])
             results[b].append(res)
-            print(f"round {r + 1} {b}: steady {res['steady'] * 1e3:.2f} ms, remesh {res['remesh']:.3f} s "
+            solve = f" (solve {res['solve'] * 1e3:.2f} ms)" if "solve" in res else ""
+            print(f"round {r + 1} {b}: steady {res['steady'] * 1e3:.2f} ms{solve}, remesh {res['remesh']:.3f} s "
                   f"({res['cells']} cells, {res['package']})", flush=True)
-    med = {b: {k: statistics.median(x[k] for x in results[b]) for k in ("steady", "remesh")} for b in builds}
+    keys = [k for k in ("steady", "solve", "remesh") if k in results[builds[0]][0]]
+    med = {b: {k: statistics.median(x[k] for x in results[b]) for k in keys} for b in builds}
     for b in builds:
-        print(f"{b}: flow step {med[b]['steady'] * 1e3:.2f} ms, remesh {med[b]['remesh']:.3f} s")
+        print(f"{b}: " + ", ".join(f"{k} {med[b][k]:.4f} s" for k in keys))
     old, new = builds
-    print(f"ratio second/first: flow step {med[new]['steady'] / med[old]['steady']:.3f}, "
-          f"remesh {med[new]['remesh'] / med[old]['remesh']:.3f}")
+    for k in keys:  # per round too: the rounds' spread shows how far the machine drifted
+        per_round = ", ".join(f"{y[k] / x[k]:.2f}" for x, y in zip(results[old], results[new]))
+        print(f"ratio second/first, {k}: {med[new][k] / med[old][k]:.3f} (per round {per_round})")
 
 
 if "--child" in sys.argv:

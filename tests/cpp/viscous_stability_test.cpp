@@ -121,9 +121,12 @@ TEST(ViscousStability, TheOperatorIsLinearInTheVelocities) {
 // (Dirichlet inside the packing); with every wall impermeable but one imposed point. How far below
 // is printed: the global bound is loose by design, the local one must stay within an order of
 // magnitude (it is 6-8 x below on the benchmark packings). A blocked cell takes its volume out of
-// the balance of its spheres' stars: no local bound then (0), the global one still holds.
+// the balance of its spheres' stars: no local bound then (0), the global one still holds. The
+// 32-bit factor and the multigrid, whose solve for the global bound stops at a loose residual and
+// is certified by its own check, give the double factor's global bound within 1 %.
 TEST(ViscousStability, TheBoundsAreBelowTheLimitOfTheDenseSpectrum) {
   const auto p = test::random_packing(120, 5, 0.06, 0.09);
+  double exact_global = 0;  // the double factor's
   struct Variant {
     const char* name;
     SolverKind solver;
@@ -165,6 +168,11 @@ TEST(ViscousStability, TheBoundsAreBelowTheLimitOfTheDenseSpectrum) {
     EXPECT_GT(global, 0);
     EXPECT_LE(global, limit * (1 - 1e-9));
     EXPECT_GT(global, 1e-4 * limit);
+    if (variant.solver == SolverKind::kCholesky && !variant.mixed && !variant.closed && variant.bulk_modulus == 0 &&
+        variant.cell_condition == 0)
+      exact_global = global;
+    else if (variant.mixed || variant.solver == SolverKind::kMultigrid)
+      EXPECT_NEAR(global / exact_global, 1, 0.01);
     if (variant.cell_condition == 2)
       EXPECT_EQ(local, 0);
     else

@@ -50,7 +50,7 @@ SolveStats AmgSolver::solve(const PressureSystem&, const std::vector<double>& b,
 void AmgSolver::apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
                               const SolveControl& control) const {
   x.assign(system.n_unknowns(), 0.0);
-  pcg_->solve_to_residual(b, x, 1e-10, control.max_iterations);
+  pcg_->solve_to_residual(b, x, control.inverse_tolerance, control.max_iterations);
 }
 
 }  // namespace pfv

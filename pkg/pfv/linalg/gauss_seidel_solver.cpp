@@ -50,7 +50,7 @@ SolveStats GaussSeidelSolver::solve(const PressureSystem& system, const std::vec
 void GaussSeidelSolver::apply_inverse(const PressureSystem& system, const std::vector<double>& b,
                                       std::vector<double>& x, const SolveControl& control) const {
   x.assign(system.n_unknowns(), 0.0);
-  sweep(system, b, x, 1e-10, control.relax, control.max_iterations);
+  sweep(system, b, x, control.inverse_tolerance, control.relax, control.max_iterations);
 }
 
 }  // namespace pfv

@@ -59,7 +59,7 @@ SolveStats PcgSolver::solve(const PressureSystem&, const std::vector<double>& b,
 void PcgSolver::apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
                               const SolveControl& control) const {
   x.assign(system.n_unknowns(), 0.0);
-  impl_->run(b, x, 1e-10, control.max_iterations);
+  impl_->run(b, x, control.inverse_tolerance, control.max_iterations);
 }
 
 }  // namespace pfv

@@ -32,6 +32,9 @@ struct SolveControl {
   // Refinement with a 32-bit factor and multigrid CG: estimated error relative to the spread of p.
   double refinement_tolerance = 1e-10;
   int max_refinement_passes = 8;
+  // apply_inverse of the iterative solvers: |r|/|b| (Gauss-Seidel: max|dx|/max|x|). The
+  // eigenvalue estimates need it tight; a caller that certifies its own result may loosen it.
+  double inverse_tolerance = 1e-10;
 };
 
 // What the last solve did, each count named for what it counts.
@@ -52,8 +55,8 @@ class PressureSolver {
   // the couplings to the Dirichlet cells.
   virtual SolveStats solve(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
                            const SolveControl& control) = 0;
-  // x ~ G^-1 b to the accuracy an eigenvalue estimate needs (1e-7 relative or better), from
-  // x = 0, without changing what the next solve() does: the stability limit's operator.
+  // x ~ G^-1 b to control.inverse_tolerance (exact with a factor), from x = 0, without changing
+  // what the next solve() does: the stability limit's operator.
   virtual void apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
                              const SolveControl& control) const = 0;
   // Whether the next solve() should start from pressures extrapolated from the last two steps

@@ -39,6 +39,7 @@ CholmodSolver::~CholmodSolver() {
 }
 
 void CholmodSolver::release() {
+  prefault_.stop();
   cholmod_common* c = &common_->c;
   if (factor_) {
     auto* f = static_cast<cholmod_factor*>(factor_);
@@ -167,6 +168,7 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
   factor_ = f;
   lend_values(f);
   numeric_factorization(s);
+  prefault_.stop();  // every page of the factor has been written
   plan_substitution(s, precision == FactorPrecision::kScaled32 ? min_scaled_entries : kNever);
 }
 
@@ -186,9 +188,10 @@ namespace {
 // block, does not pay. Smaller blocks stay on 4 kB pages (a 2 MB page per engine would be
 // most of a small factor). The advice is only advice: without it, or refused, the block works
 // the same (the measured effect: doc/benchmarks.md). Returns the capacity in doubles.
+constexpr std::size_t kHugeFrom = std::size_t{8} << 20;
+
 std::size_t allocate_values(std::size_t doubles, std::unique_ptr<double[], CholmodSolver::FreeValues>& out) {
   constexpr std::size_t kHugePage = std::size_t{1} << 21;
-  constexpr std::size_t kHugeFrom = std::size_t{8} << 20;
   std::size_t bytes = doubles * sizeof(double);
   void* p = nullptr;
   if (bytes >= kHugeFrom) {
@@ -214,9 +217,12 @@ void CholmodSolver::lend_values(void* factor) {
   auto* f = static_cast<cholmod_factor*>(factor);
   if (!f->is_super || f->xtype != CHOLMOD_PATTERN) return;  // CHOLMOD allocates, as without us
   if (value_capacity_ < f->xsize) {
+    prefault_.stop();
     values_.reset();  // the old storage first: one block at a time
     value_capacity_ = 0;
     value_capacity_ = allocate_values(f->xsize + f->xsize / 8, values_);
+    // The factorisation's arithmetic outlasts the kernel's clearing of the pages it will write.
+    if (f->xsize * sizeof(double) >= kHugeFrom) prefault_.start(values_.get(), f->xsize * sizeof(double));
   }
   f->x = values_.get();
   f->xtype = CHOLMOD_REAL;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "pfv/linalg/page_prefault.hpp"
 #include "pfv/linalg/parallel_substitution.hpp"
 #include "pfv/linalg/supernodal_numeric.hpp"
 
@@ -148,6 +149,9 @@ class CholmodSolver {
   // (lend_values), so that the first factorisation faults in a few large pages rather than one per 4 kB.
   std::unique_ptr<double[], FreeValues> values_;
   std::size_t value_capacity_ = 0;
+  // Populates a fresh values_ block on another CPU while the first factorisation into it computes
+  // (page_prefault.hpp); stopped when that factorisation ends and before the block is freed.
+  PagePrefault prefault_;
   std::vector<long> trapezoid_start_;  // where each supernode's block starts (compacted values)
   std::vector<double> scale_;          // per column (elimination order) with kScaled32; empty in double
   ParallelSubstitution parallel_;

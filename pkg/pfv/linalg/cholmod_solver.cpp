@@ -1,7 +1,6 @@
 #include "pfv/linalg/cholmod_solver.hpp"
 
 #include <suitesparse/cholmod.h>
-#include <sys/mman.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -181,32 +180,22 @@ void CholmodSolver::FreeValues::operator()(double* p) const { std::free(p); }
 
 namespace {
 
-// Storage of at least 'doubles' values, uninitialised (no page touched here). From 8 MB on,
-// aligned to 2 MB and advised for transparent huge pages (the kernel's default mode on Debian
-// is "madvise"): the first factorisation of a fresh engine otherwise takes one page fault per
-// 4 kB of the factor (10 000 spheres: 41 MB, 10 000 faults), which a remesh, reusing the
-// block, does not pay. Smaller blocks stay on 4 kB pages (a 2 MB page per engine would be
-// most of a small factor). The advice is only advice: without it, or refused, the block works
-// the same (the measured effect: doc/benchmarks.md). Returns the capacity in doubles.
-constexpr std::size_t kHugeFrom = std::size_t{8} << 20;
-
+// Storage of at least 'doubles' values, uninitialised (no page touched here). On 4 kB pages:
+// the block is written first by a factorisation, whose page faults a helper takes on another
+// CPU (lend_values), and with Debian's default transparent-huge-page settings ("madvise" for
+// both the mode and the defragmentation) a block advised for huge pages has each 2 MB fault
+// compact memory first, which made the first write several times slower than on 4 kB pages
+// (doc/benchmarks.md, "Start-up"). Returns the capacity in doubles.
 std::size_t allocate_values(std::size_t doubles, std::unique_ptr<double[], CholmodSolver::FreeValues>& out) {
-  constexpr std::size_t kHugePage = std::size_t{1} << 21;
-  std::size_t bytes = doubles * sizeof(double);
-  void* p = nullptr;
-  if (bytes >= kHugeFrom) {
-    bytes = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-    p = std::aligned_alloc(kHugePage, bytes);
-#ifdef MADV_HUGEPAGE
-    if (p) madvise(p, bytes, MADV_HUGEPAGE);
-#endif
-  } else {
-    p = std::malloc(bytes);
-  }
+  void* p = std::malloc(doubles * sizeof(double));
   if (!p) throw std::bad_alloc();
   out.reset(static_cast<double*>(p));
-  return bytes / sizeof(double);
+  return doubles;
 }
+
+// Blocks from this size on are populated by a helper while the first factorisation into them
+// runs: below it, starting a thread costs about what it would save.
+constexpr std::size_t kPrefaultFrom = std::size_t{8} << 20;
 
 }  // namespace
 
@@ -222,7 +211,7 @@ void CholmodSolver::lend_values(void* factor) {
     value_capacity_ = 0;
     value_capacity_ = allocate_values(f->xsize + f->xsize / 8, values_);
     // The factorisation's arithmetic outlasts the kernel's clearing of the pages it will write.
-    if (f->xsize * sizeof(double) >= kHugeFrom) prefault_.start(values_.get(), f->xsize * sizeof(double));
+    if (f->xsize * sizeof(double) >= kPrefaultFrom) prefault_.start(values_.get(), f->xsize * sizeof(double));
   }
   f->x = values_.get();
   f->xtype = CHOLMOD_REAL;

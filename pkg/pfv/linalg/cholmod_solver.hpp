@@ -142,11 +142,10 @@ class CholmodSolver {
   double max_entries_ = kNever;
   void* factor_ = nullptr;  // cholmod_factor*
   // The factor's numeric values, lent to CHOLMOD (which otherwise allocates them afresh at
-  // every factorisation). A factor of tens of thousands of spheres takes hundreds of MB;
-  // glibc serves blocks that large from new mappings, whose first touch faults in every
-  // page. Kept across release(), it makes the pages of one remesh the pages of the next. Only grown, with 1/8 headroom
-  // for the next remeshes. A large block is aligned to 2 MB and offered to the kernel for transparent huge pages
-  // (lend_values), so that the first factorisation faults in a few large pages rather than one per 4 kB.
+  // every factorisation). A factor of tens of thousands of spheres takes hundreds of MB; glibc
+  // serves blocks that large from new mappings, whose first touch faults in every page. Kept
+  // across release(), it makes the pages of one remesh the pages of the next. Only grown, with
+  // 1/8 headroom for the next remeshes.
   std::unique_ptr<double[], FreeValues> values_;
   std::size_t value_capacity_ = 0;
   // Populates a fresh values_ block on another CPU while the first factorisation into it computes

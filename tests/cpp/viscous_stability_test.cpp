@@ -169,10 +169,11 @@ TEST(ViscousStability, TheBoundsAreBelowTheLimitOfTheDenseSpectrum) {
     EXPECT_LE(global, limit * (1 - 1e-9));
     EXPECT_GT(global, 1e-4 * limit);
     if (variant.solver == SolverKind::kCholesky && !variant.mixed && !variant.closed && variant.bulk_modulus == 0 &&
-        variant.cell_condition == 0)
+        variant.cell_condition == 0) {
       exact_global = global;
-    else if (variant.mixed || variant.solver == SolverKind::kMultigrid)
+    } else if (variant.mixed || variant.solver == SolverKind::kMultigrid) {
       EXPECT_NEAR(global / exact_global, 1, 0.01);
+    }
     if (variant.cell_condition == 2)
       EXPECT_EQ(local, 0);
     else

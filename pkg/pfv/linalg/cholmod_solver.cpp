@@ -182,10 +182,10 @@ namespace {
 
 // Storage of at least 'doubles' values, uninitialised (no page touched here). On 4 kB pages:
 // the block is written first by a factorisation, whose page faults a helper takes on another
-// CPU (lend_values), and with Debian's default transparent-huge-page settings ("madvise" for
-// both the mode and the defragmentation) a block advised for huge pages has each 2 MB fault
-// compact memory first, which made the first write several times slower than on 4 kB pages
-// (doc/benchmarks.md, "Start-up"). Returns the capacity in doubles.
+// CPU (lend_values). With Debian's default transparent-huge-page settings ("madvise" for both
+// the mode and the defragmentation) a fault in a block advised for huge pages may reclaim and
+// compact memory directly, and its first write measured several times slower than on 4 kB
+// pages (doc/benchmarks.md, "Start-up"). Returns the capacity in doubles.
 std::size_t allocate_values(std::size_t doubles, std::unique_ptr<double[], CholmodSolver::FreeValues>& out) {
   void* p = std::malloc(doubles * sizeof(double));
   if (!p) throw std::bad_alloc();

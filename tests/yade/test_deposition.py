@@ -133,8 +133,7 @@ def main():
         below = np.flatnonzero(ratio[start:, k] < 0.5)
         drop.append(t[start + below[0]] if len(below) else math.inf)
     # Two level pairs whose smoothed gradients cross i_c / 2 within one smoothing window of each other fall
-    # together as far as this signal can tell (the grains' motion is chaotic: round-off alone reorders such near
-    # ties from one build to the next).
+    # together as far as this signal can tell: their order is below its resolution.
     window = t[min(len(kernel), len(t) - 1)] - t[0]
     rb.check("the gradient falls level after level from the bottom up", all(np.isfinite(drop))
              and all(a <= b + window for a, b in zip(drop, drop[1:])) and drop[0] < drop[-1],

@@ -86,9 +86,8 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
 
   // z ~ G^-1 beta, then scaled by q = max beta_u / (G z)_u so that G (q z) >= beta entry by entry.
   // The scaling certifies z whatever its accuracy, and costs the bound a factor of about q, so a
-  // conjugate-gradient solver stops at a relative residual of 1e-4 (q within a few 1e-3 of 1; the
-  // tolerance of an exact solve takes about twice the iterations from zero), and so does each
-  // refinement pass. Gauss-Seidel's stopping rule (the last sweep's change) says nothing of the
+  // conjugate-gradient solver stops at a relative residual of 1e-4, far short of an exact solve,
+  // and so does each refinement pass. Gauss-Seidel's stopping rule (the last sweep's change) says nothing of the
   // residual: it keeps the tight tolerance.
   // One substitution of a 32-bit factor leaves q within a few 1e-4 of 1. Should q exceed 1.01, or
   // (G z)_u be <= 0 somewhere, refinement passes improve z; a z they leave with q > 2 gives no bound.

@@ -206,8 +206,7 @@ void CholmodSolver::lend_values(void* factor) {
   auto* f = static_cast<cholmod_factor*>(factor);
   if (!f->is_super || f->xtype != CHOLMOD_PATTERN) return;  // CHOLMOD allocates, as without us
   if (value_capacity_ < f->xsize) {
-    prefault_.stop();
-    values_.reset();  // the old storage first: one block at a time
+    values_.reset();  // the old storage first (release() has stopped any helper populating it)
     value_capacity_ = 0;
     value_capacity_ = allocate_values(f->xsize + f->xsize / 8, values_);
     // The factorisation's arithmetic outlasts the kernel's clearing of the pages it will write.

@@ -1,6 +1,7 @@
 #include "pfv/linalg/parallel_substitution.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <numeric>
 #include <type_traits>
 #ifdef _OPENMP
@@ -66,15 +67,58 @@ inline void subtract_columns(const Stored* block, int nsrow, int j0, int j1, con
 }
 
 // Columns [j0, j1) of the block's dense triangle, forwards, on u (the block's rows, from row
-// 0): u(j) /= L(j, j), then the rows j+1..j1-1 below it. Leaves u(j) * scale(j) in x.
+// 0): u(j) times the reciprocal of L(j, j) ('inverse', indexed like the columns), then the
+// rows j+1..j1-1 below it. Leaves u(j) * scale(j) in x.
 template <class Stored>
-inline void solve_triangle(const Stored* block, const double* scale, int nsrow, int j0, int j1, double* u, double* x) {
+inline void solve_triangle(const Stored* block, const double* scale, const double* inverse, int nsrow, int j0, int j1,
+                           double* u, double* x) {
   for (int j = j0; j < j1; ++j) {
     const Stored* col = trapezoid_column(block, nsrow, j);
-    const double sj = column_scale<Stored>(scale, j);
-    const double xj = (u[j] /= value(col[j]) * sj) * sj;
+    const double xj = (u[j] *= inverse[j]) * column_scale<Stored>(scale, j);
     x[j] = xj;
     for (int i = j + 1; i < j1; ++i) u[i] -= value(col[i]) * xj;
+  }
+}
+
+// Four consecutive entries as doubles (GCC/Clang vector extensions: AVX where the kernels are
+// built for it, pairs of SSE registers otherwise).
+using Double4 = double __attribute__((vector_size(32)));
+using Int4 = std::int32_t __attribute__((vector_size(16)));
+inline Double4 load4(const double* p) {
+  Double4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline Double4 load4(const std::int32_t* p) {
+  Int4 v;
+  std::memcpy(&v, p, sizeof v);
+  return __builtin_convertvector(v, Double4);
+}
+
+// sum[c] = sum over i < count of column c's entry i times u[i], for the four columns c0..c3:
+// one pass over u for the four, each with its own accumulator.
+template <class Stored>
+inline void dot4(const Stored* c0, const Stored* c1, const Stored* c2, const Stored* c3, const double* u, int count,
+                 double sum[4]) {
+  Double4 a0 = {0, 0, 0, 0}, a1 = a0, a2 = a0, a3 = a0;
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const Double4 v = load4(u + i);
+    a0 += load4(c0 + i) * v;
+    a1 += load4(c1 + i) * v;
+    a2 += load4(c2 + i) * v;
+    a3 += load4(c3 + i) * v;
+  }
+  sum[0] = (a0[0] + a0[1]) + (a0[2] + a0[3]);
+  sum[1] = (a1[0] + a1[1]) + (a1[2] + a1[3]);
+  sum[2] = (a2[0] + a2[1]) + (a2[2] + a2[3]);
+  sum[3] = (a3[0] + a3[1]) + (a3[2] + a3[3]);
+  for (; i < count; ++i) {
+    const double v = u[i];
+    sum[0] += value(c0[i]) * v;
+    sum[1] += value(c1[i]) * v;
+    sum[2] += value(c2[i]) * v;
+    sum[3] += value(c3[i]) * v;
   }
 }
 
@@ -216,50 +260,80 @@ void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
   work_.assign(buffers, std::vector<double>(max_rows, 0.0));
   scaled_.assign(f.scaled ? buffers : 0, std::vector<double>(max_rows, 0.0));
   y_.assign(f.n, 0.0);
+  inverse_.resize(f.n);
+  for (int s = 0; s < ns; ++s) {
+    const int nsrow = f.pi[s + 1] - f.pi[s];
+    for (int j = 0; j < f.super[s + 1] - f.super[s]; ++j) {
+      const int k = f.super[s] + j;
+      const double diagonal = f.scaled ? trapezoid_column(f.scaled + f.start[s], nsrow, j)[j] * f.scale[k]
+                                       : trapezoid_column(f.values + f.start[s], nsrow, j)[j];
+      inverse_[k] = 1.0 / diagonal;
+    }
+  }
 }
 
 template <class Stored>
 void ParallelSubstitution::forward(const Stored* values, int s, int thread, bool top) {
   const Block<Stored> b = block(values, s);
-  const int nrest = b.nsrow - b.nscol;
   prefetch_ahead(b.L, values + L_.start[s + 1], values + L_.start[L_.nsuper]);
-  double* y = y_.data() + b.k1;  // this supernode's rows
-  double* x = y;                 // y(j) * scale(j), the same as y for double entries
+  double* y = y_.data();
+  double* u = work_[thread].data();  // its own rows, then minus the updates of the rows below
+  double* x = u;                     // y(j) * scale(j), the same as y for double entries
   if constexpr (!std::is_same_v<Stored, double>) x = scaled_[thread].data();
-  solve_triangle(b.L, b.scale, b.nsrow, 0, b.nscol, y, x);
-  // The rectangle below it: w = -L21 y1.
-  double* w = work_[thread].data();
-  std::fill(w, w + nrest, 0.0);
-  subtract_columns(b.L, b.nsrow, 0, b.nscol, x, b.nscol, w, nrest);
-  double* all = y_.data();
+  std::copy(y + b.k1, y + b.k1 + b.nscol, u);
+  std::fill(u + b.nscol, u + b.nsrow, 0.0);
+  const double* inverse = inverse_.data() + b.k1;
+  for (int j0 = 0; j0 < b.nscol; j0 += kColumnBlock) {
+    const int j1 = std::min(j0 + kColumnBlock, b.nscol);
+    solve_triangle(b.L, b.scale, inverse, b.nsrow, j0, j1, u, x);
+    subtract_columns(b.L, b.nsrow, j0, j1, x, j1, u + j1, b.nsrow - j1);
+  }
+  std::copy(u, u + b.nscol, y + b.k1);
+  const double* w = u + b.nscol;
+  const int nrest = b.nsrow - b.nscol;
   if (!top) {  // top rows are shared between threads: collect their updates apart
     double* acc = acc_[thread].data();
     for (int i = 0; i < nrest; ++i) {
       if (top_row_[b.rows[i]])
         acc[b.rows[i]] -= w[i];
       else
-        all[b.rows[i]] += w[i];
+        y[b.rows[i]] += w[i];
     }
   } else {
-    for (int i = 0; i < nrest; ++i) all[b.rows[i]] += w[i];
+    for (int i = 0; i < nrest; ++i) y[b.rows[i]] += w[i];
   }
 }
 
 template <class Stored>
 void ParallelSubstitution::backward(const Stored* values, int s, int thread) {
   const Block<Stored> b = block(values, s);
-  const int nrest = b.nsrow - b.nscol;
   prefetch_behind(b.L, values + L_.start[s + 1], values);
   double* y = y_.data();
-  double* w = work_[thread].data();
-  for (int i = 0; i < nrest; ++i) w[i] = y[b.rows[i]];
-  y += b.k1;
-  for (int j = b.nscol - 1; j >= 0; --j) {
-    const Stored* col = trapezoid_column(b.L, b.nsrow, j);
-    const double sj = column_scale<Stored>(b.scale, j);
-    const double t = y[j] - (dot(col + b.nscol, w, nrest) + dot(col + j + 1, y + j + 1, b.nscol - j - 1)) * sj;
-    y[j] = t / (value(col[j]) * sj);
+  double* u = work_[thread].data();  // its own rows, then the rows below
+  std::copy(y + b.k1, y + b.k1 + b.nscol, u);
+  for (int i = b.nscol; i < b.nsrow; ++i) u[i] = y[b.rows[i - b.nscol]];
+  const double* inverse = inverse_.data() + b.k1;
+  for (int j1 = b.nscol; j1 > 0;) {
+    const int j0 = (j1 - 1) / kColumnBlock * kColumnBlock;  // the forward sweep's blocks
+    // The block's columns against the rows below the block (all known), then its triangle.
+    double below[kColumnBlock];
+    const int count = b.nsrow - j1;
+    if (j1 - j0 == 4) {
+      dot4(trapezoid_column(b.L, b.nsrow, j0) + j1, trapezoid_column(b.L, b.nsrow, j0 + 1) + j1,
+           trapezoid_column(b.L, b.nsrow, j0 + 2) + j1, trapezoid_column(b.L, b.nsrow, j0 + 3) + j1, u + j1, count,
+           below);
+    } else {
+      for (int j = j0; j < j1; ++j) below[j - j0] = dot(trapezoid_column(b.L, b.nsrow, j) + j1, u + j1, count);
+    }
+    for (int j = j1 - 1; j >= j0; --j) {
+      const Stored* col = trapezoid_column(b.L, b.nsrow, j);
+      double d = below[j - j0];
+      for (int i = j + 1; i < j1; ++i) d += value(col[i]) * u[i];
+      u[j] = (u[j] - d * column_scale<Stored>(b.scale, j)) * inverse[j];
+    }
+    j1 = j0;
   }
+  std::copy(u, u + b.nscol, y + b.k1);
 }
 
 namespace {
@@ -294,7 +368,7 @@ void ParallelSubstitution::forward_shared(const Stored* values, int s, int t, in
   barrier();
   for (int j0 = 0; j0 < b.nscol; j0 += kSharedBlock) {
     const int j1 = std::min(j0 + kSharedBlock, b.nscol);
-    if (t == 0) solve_triangle(b.L, b.scale, b.nsrow, j0, j1, u, x);
+    if (t == 0) solve_triangle(b.L, b.scale, inverse_.data() + b.k1, b.nsrow, j0, j1, u, x);
     barrier();
     const auto [lo, hi] = share(j1, b.nsrow, t, nt);
     subtract_columns(b.L, b.nsrow, j0, j1, x, lo, u + lo, hi - lo);
@@ -332,7 +406,7 @@ void ParallelSubstitution::backward_shared(const Stored* values, int s, int t, i
       for (int j = j1 - 1; j >= j0; --j) {
         const Stored* col = trapezoid_column(b.L, b.nsrow, j);
         const double sj = column_scale<Stored>(b.scale, j);
-        u[j] = (u[j] - dot(col + j + 1, u + j + 1, j1 - j - 1) * sj) / (value(col[j]) * sj);
+        u[j] = (u[j] - dot(col + j + 1, u + j + 1, j1 - j - 1) * sj) * inverse_[b.k1 + j];
       }
     barrier();
     j1 = j0;

@@ -44,6 +44,15 @@ class ParallelSubstitution {
   int shared_top_supernodes() const { return static_cast<int>(std::count(shared_.begin(), shared_.end(), 1)); }
   static constexpr long kMinSharedEntries = 1 << 16;
   static constexpr int kSharedBlock = 64;
+  // Every other supernode is solved by blocks of kColumnBlock columns: the block's small
+  // triangle, then its columns against all the rows below it in one sweep (forwards, four
+  // columns per sweep) or in four dots sharing one pass over the known rows (backwards). The
+  // chain of dependent operations, from one column's value to the next, is then a block's
+  // triangle and a multiplication by the reciprocal of the diagonal, precomputed per factor;
+  // column by column it went through a division and a dot's reduction at every column, and
+  // that latency, not the reading of the factor, bounded the narrow supernodes that hold most
+  // entries.
+  static constexpr int kColumnBlock = 4;
   // x = (L L')^-1 applied to b in the original ordering. With parallel = false the groups
   // and the shared supernodes' pieces run one after the other on the calling thread (same
   // arithmetic, the same result to the bit).
@@ -93,6 +102,7 @@ class ParallelSubstitution {
   // columns (32-bit entries); the permuted right-hand side and solution.
   std::vector<std::vector<double>> acc_, work_, scaled_;
   std::vector<double> y_;
+  std::vector<double> inverse_;  // per column, in elimination order: 1 / L(j, j), set by plan()
   double top_fraction_ = 1;
 };
 

@@ -278,7 +278,7 @@ void ParallelSubstitution::forward(const Stored* values, int s, int thread, bool
   prefetch_ahead(b.L, values + L_.start[s + 1], values + L_.start[L_.nsuper]);
   double* y = y_.data();
   double* u = work_[thread].data();  // its own rows, then minus the updates of the rows below
-  double* x = u;                     // y(j) * scale(j), the same as y for double entries
+  double* x = u;                     // y(j) * scale(j), the same as u for double entries
   if constexpr (!std::is_same_v<Stored, double>) x = scaled_[thread].data();
   std::copy(y + b.k1, y + b.k1 + b.nscol, u);
   std::fill(u + b.nscol, u + b.nsrow, 0.0);
@@ -318,7 +318,8 @@ void ParallelSubstitution::backward(const Stored* values, int s, int thread) {
     // The block's columns against the rows below the block (all known), then its triangle.
     double below[kColumnBlock];
     const int count = b.nsrow - j1;
-    if (j1 - j0 == 4) {
+    static_assert(kColumnBlock == 4, "a whole block is one dot4");
+    if (j1 - j0 == kColumnBlock) {
       dot4(trapezoid_column(b.L, b.nsrow, j0) + j1, trapezoid_column(b.L, b.nsrow, j0 + 1) + j1,
            trapezoid_column(b.L, b.nsrow, j0 + 2) + j1, trapezoid_column(b.L, b.nsrow, j0 + 3) + j1, u + j1, count,
            below);

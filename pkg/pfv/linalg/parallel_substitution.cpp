@@ -81,7 +81,8 @@ inline void solve_triangle(const Stored* block, const double* scale, const doubl
 }
 
 // Four consecutive entries as doubles (GCC/Clang vector extensions: AVX where the kernels are
-// built for it, pairs of SSE registers otherwise).
+// built for it, pairs of SSE registers otherwise). dot4 is written with them because GCC
+// vectorises its plain-array form by shuffling the four accumulators through the stack.
 using Double4 = double __attribute__((vector_size(32)));
 using Int4 = std::int32_t __attribute__((vector_size(16)));
 inline Double4 load4(const double* p) {

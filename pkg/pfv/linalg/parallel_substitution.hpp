@@ -48,10 +48,10 @@ class ParallelSubstitution {
   // triangle, then its columns against all the rows below it in one sweep (forwards, four
   // columns per sweep) or in four dots sharing one pass over the known rows (backwards). The
   // chain of dependent operations, from one column's value to the next, is then a block's
-  // triangle and a multiplication by the reciprocal of the diagonal, precomputed per factor;
-  // column by column it went through a division and a dot's reduction at every column, and
-  // that latency, not the reading of the factor, bounded the narrow supernodes that hold most
-  // entries.
+  // triangle and a multiplication by the reciprocal of the diagonal, precomputed per factor.
+  // Column by column, every column would wait for a division and a dot's reduction, and that
+  // latency, not the reading of the factor, would bound the narrow supernodes that hold most
+  // of the entries.
   static constexpr int kColumnBlock = 4;
   // x = (L L')^-1 applied to b in the original ordering. With parallel = false the groups
   // and the shared supernodes' pieces run one after the other on the calling thread (same

@@ -1,7 +1,7 @@
 """Stage measurements behind doc/benchmarks.md (stage measurements) and doc/solvers.md, on the cached benchmark
 packing (made by bench/flow_benchmark.py).
 
-    yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6,7,8]
+    yade-double -j1 -n -x bench/solver_stages.py [--size=10000] [--sections=1,2,3,4,5,6,7,8,9]
 
 1. ordering reuse: CHOLMOD analysis with a fresh METIS ordering and with the ordering carried over from the previous
    mesh, for the same positions and after moving every sphere at random by 0.5 % and 2 % of the mean radius
@@ -31,6 +31,9 @@ packing (made by bench/flow_benchmark.py).
    never written (a fresh mapping, which the kernel zeroes page by page on the first write) against writing it
    again, with transparent huge pages (numpy's madvise) and with 4 kB pages, three fresh blocks each, alternating and
    all kept: the cost a first factorisation pays and a remesh, reusing its storage, does not.
+9. the first geometric ordering on one and on two OpenMP threads (the dissection's subtrees split in parallel):
+   fresh engines, the two thread counts alternating; the analysis stage (the ordering and CHOLMOD's symbolic
+   factorisation) and nnz(L), which is the same when the order is.
 Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers;
 section 2 imitates the DEM's eviction of the factor).
 """
@@ -294,6 +297,28 @@ def first_touch(pos, rad, walls):
             pages, ', '.join('%.2f' % x[0] for x in r), ', '.join('%.1f' % x[1] for x in r)))
 
 
+def parallel_ordering(pos, rad, walls, repeats=5):
+    """Section 9: the first geometric ordering on one and on two threads."""
+    print('9. first geometric ordering, 1 and 2 OpenMP threads alternating (%d fresh engines each)' % repeats)
+    threads = pfv.get_max_threads()
+    analysis, entries = {1: [], 2: []}, {1: set(), 2: set()}
+    try:
+        for _ in range(repeats):
+            for t in (1, 2):
+                pfv.set_num_threads(t)
+                e = engine()
+                e.ordering = 'geometric'
+                e.step(pos, rad, walls, 1e-4)
+                analysis[t].append(e.remesh_times()['analysis'])
+                entries[t].add(e.factor_nonzeros())
+    finally:
+        pfv.set_num_threads(threads)
+    for t in (1, 2):
+        print('   %d thread%s: analysis %s; nnz(L) %s' % (t, 's' if t > 1 else '', stats(analysis[t]),
+                                                          ', '.join('%d' % x for x in sorted(entries[t]))))
+    print('   two threads / one (medians): %.2f' % (np.median(analysis[2]) / np.median(analysis[1])))
+
+
 def main():
     n = option('size', 10000)
     spheres, meta = fb.read_packing(n)
@@ -302,7 +327,7 @@ def main():
     L = meta.get('box', fb.box_side(n))
     walls = [0, L, 0, L, 0, L]
     print('solver_stages: N = %d, packing %s' % (n, fb.packing_path(n)))
-    sections = option('sections', '1,2,3,4,5,6,7,8').split(',')
+    sections = option('sections', '1,2,3,4,5,6,7,8,9').split(',')
     if '1' in sections:
         ordering(pos, rad, walls)
     if '2' in sections:
@@ -315,6 +340,8 @@ def main():
         ordering_threshold(pos, rad, L)
     if '8' in sections:
         first_touch(pos, rad, walls)
+    if '9' in sections:
+        parallel_ordering(pos, rad, walls)
     if '5' in sections:
         remesh_sequence(n)
     return 0

@@ -1,7 +1,9 @@
 // The geometric nested dissection (geometric_ordering.hpp): a permutation of the unknowns, a
 // factor about as small as METIS's and far smaller than AMD's, the same pressures, carried over
-// at remesh and computed afresh (not by METIS) when the carried order fills too much.
+// at remesh and computed afresh (not by METIS) when the carried order fills too much; the same
+// order whatever the number of threads splitting the parts.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -52,6 +54,25 @@ TEST(GeometricOrdering, IsAPermutationOfTheUnknowns) {
   GeometricOrderingOptions tiny;
   tiny.leaf_size = 2;  // dissected down to pairs: every band and flow degenerate case is met
   EXPECT_TRUE(is_permutation_of_unknowns(geometric_ordering(e.system(), power_centres(e), tiny), n));
+}
+
+TEST(GeometricOrdering, TheSameOrderOnAnyNumberOfThreads) {
+  // Parts whose subtrees are split in parallel touch disjoint entries of the shared arrays:
+  // the order must not depend on which thread splits which part, or when.
+  const FlowEngine e = solved(test::random_packing(600, 34), Ordering::kAuto);
+  const auto point = power_centres(e);
+  GeometricOrderingOptions tiny;
+  tiny.leaf_size = 2;
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const std::vector<int> serial = geometric_ordering(e.system(), point),
+                         serial_tiny = geometric_ordering(e.system(), point, tiny);
+  for (int t : {2, 3, 4}) {
+    omp_set_num_threads(t);
+    EXPECT_EQ(geometric_ordering(e.system(), point), serial) << t << " threads";
+    EXPECT_EQ(geometric_ordering(e.system(), point, tiny), serial_tiny) << t << " threads";
+  }
+  omp_set_num_threads(threads);
 }
 
 TEST(GeometricOrdering, CoincidentPointsStillGiveAPermutation) {

@@ -12,7 +12,9 @@
 // work: one selection (nth_element) per level and a flow in a band of O(m^(2/3)) cells per part
 // of m. CAMD then orders each level's cells by minimum degree, all leaves before the deepest
 // separators and each separator before the ones above it, the order nested dissection
-// prescribes (George 1973; the measurements in doc/solvers.md).
+// prescribes (George 1973; the measurements in doc/solvers.md). Below the first few splits the
+// parts are split in parallel by the OpenMP threads, each subtree by one thread; the order does
+// not depend on the number of threads.
 #pragma once
 #include <array>
 #include <vector>

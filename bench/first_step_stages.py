@@ -1,0 +1,44 @@
+"""The first step of the C++ engine alone, by stage, for several solvers, on bench/growth.py's jittered lattice.
+
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=build/python /usr/bin/python3 bench/first_step_stages.py \
+        [N] [--solvers=auto,multigrid]
+
+Scene as bench/core_steady.py (permeameter along y, static spheres, `pfv.Engine` without YADE). For each solver in
+turn, one fresh engine: the wall time of its first step, the stages of its first mesh (`remesh_times()`), the first
+solve (`step_times()`), and the engine's report of its choice (`solver_choice`). Under `solver="auto"` the
+"analysis" stage is the fill-reducing ordering and CHOLMOD's symbolic factorisation that project the factor's size
+against the budget (half the available memory), which it pays whichever solver it then takes. No timing is asserted.
+"""
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from core_steady import lattice_permeameter  # noqa: E402
+
+STAGES = ('triangulation', 'geometry', 'conductance', 'force_cache', 'assembly', 'analysis', 'factorization')
+
+
+def first_step(n, solver):
+    e, pos, rad, walls = lattice_permeameter(n)
+    e.solver = solver
+    t0 = time.perf_counter()
+    e.step(pos, rad, walls, 1e-4)
+    wall = time.perf_counter() - t0
+    return wall, dict(e.remesh_times()), e.step_times()['solve'], e.solver_choice
+
+
+def main(argv):
+    n = next((int(float(a)) for a in argv if not a.startswith('--')), 500000)
+    solvers = next((a.split('=', 1)[1] for a in argv if a.startswith('--solvers=')), 'auto,multigrid').split(',')
+    print('| N | solver | first step [s] | %s | first solve [s] | choice |' % ' | '.join(STAGES))
+    print('|---|---|---|%s---|---|' % ('---|' * len(STAGES)))
+    for solver in solvers:
+        wall, stages, solve, choice = first_step(n, solver)
+        cells = ' | '.join('%.2f' % stages[k] for k in STAGES)
+        print('| %d | %s | %.1f | %s | %.2f | %s |' % (n, solver, wall, cells, solve, choice), flush=True)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))

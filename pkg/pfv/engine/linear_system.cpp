@@ -99,12 +99,13 @@ double factor_entry_budget(const EngineSettings& s, const PressureSolver* recycl
   return bytes / sizeof(double);
 }
 
+// Four significant digits: a factor and the budget it is compared with may agree to three.
 std::string bytes_text(double bytes) {
   char text[32];
   if (bytes >= 1e9)
-    std::snprintf(text, sizeof text, "%.3g GB", bytes / 1e9);
+    std::snprintf(text, sizeof text, "%.4g GB", bytes / 1e9);
   else
-    std::snprintf(text, sizeof text, "%.3g MB", bytes / 1e6);
+    std::snprintf(text, sizeof text, "%.4g MB", bytes / 1e6);
   return text;
 }
 

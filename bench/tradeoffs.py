@@ -1,7 +1,7 @@
 """Speed/accuracy study of the PFV engine's options: solver, tolerance, remesh schedule.
 
     PYTHONPATH=build/python OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 \\
-        /usr/bin/python3.11 bench/tradeoffs.py [--quick] [--out=doc/tradeoffs.md] [--jobs=2]
+        /usr/bin/python3.11 bench/tradeoffs.py [--quick] [--out=doc/tradeoffs.md] [--jobs=1]
         [--sizes=1000,5000] [--rounds=3] [--figure=doc/figures/tradeoffs.png] [--work=/tmp/trade]
         [--report-only]      (re-render the report from the part files in --work, no measurement)
         [--part=SCENE:N]     (internal: measure one scene at one size, write --work/part_SCENE_N.json)

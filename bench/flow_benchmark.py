@@ -8,6 +8,7 @@ Run with YADE (the driver re-invokes yade-double on this file for every measurem
                 [--steady=20]
                 [--gen-threads=T]    (threads of the child that generates a missing packing; default max of --threads)
     yade-double -n -x bench/flow_benchmark.py --report-only --json=FILE [--out=doc/benchmarks.md]
+    yade-double -n -x bench/flow_benchmark.py --startup --report-only --json=FILE [--out=doc/benchmarks.md]
                 (the report of an earlier full run from its JSON, for a change of the report's layout)
     yade-double -n -x bench/flow_benchmark.py --startup [--sizes=10000,50000] [--rounds=3] [--threads=1]
                 [--steady=5] [--out=doc/benchmarks.md]
@@ -681,6 +682,11 @@ def startup_summary(data):
                              cpu_share=median(cpu),
                              parts=pair_medians)
         row['pfv_over_yade_first'] = row['pfv']['first'] / row['yade']['first']
+        # Per round: the two engines' trials of one round ran next to each other, at the same machine speed.
+        per_round = [_window_cost(p['first'], median(p['steady']['exec'])) /
+                     _window_cost(y['first'], median(y['steady']['exec']))
+                     for y, p in zip(d['trials']['yade'], d['trials']['pfv'])]
+        row['pfv_over_yade_range'] = (min(per_round), max(per_round))
         rows[n] = row
     return rows
 
@@ -692,18 +698,20 @@ def startup_report(opts, machine, rows, command, threads):
       'the full benchmark (permeameter, CHOLMOD, no automatic remesh), %d rounds of YADE and PFV interleaved, %d '
       'steady steps. **first step** = engine execTime of the first %d steps of a fresh engine minus %d steady flow '
       'steps, **remesh** = the same from a forced remesh (`updateTriangulation=True`) of that engine; medians over '
-      'rounds of the per-trial values (the ratio first/remesh per trial). Targets: first/remesh <= 1.2, first PFV / '
-      'first YADE <= 0.5.' % (command, machine.get('Model name', '?'), threads, threads,
-                              opts['rounds'], opts['steady'], WINDOW, WINDOW - 1))
+      'rounds of the per-trial values (the ratio first/remesh per trial; first PFV / first YADE is the ratio of the '
+      'medians, its range over the rounds that of the two trials of each round). Targets: first/remesh <= 1.2, '
+      'first PFV / first YADE <= 0.5.' % (command, machine.get('Model name', '?'), threads, threads,
+                                          opts['rounds'], opts['steady'], WINDOW, WINDOW - 1))
     w('')
     w('| N | cells | first step YADE | first step PFV | remesh PFV | **first / remesh PFV** (range) | '
-      '**first PFV / first YADE** | CPU/wall steady Y / P |')
+      '**first PFV / first YADE** (range) | CPU/wall steady Y / P |')
     w('|---|---|---|---|---|---|---|---|')
     for n, r in rows.items():
         y, p = r['yade'], r['pfv']
-        w('| %s | %s | %s | %s | %s | **%.2f** (%.2f-%.2f) | **%.2f** | %.2f / %.2f |' % (
+        w('| %s | %s | %s | %s | %s | **%.2f** (%.2f-%.2f) | **%.2f** (%.2f-%.2f) | %.2f / %.2f |' % (
             n, r['cells'], fmt_t(y['first']), fmt_t(p['first']), fmt_t(p['remesh']), p['ratio'],
-            p['ratio_range'][0], p['ratio_range'][1], r['pfv_over_yade_first'], y['cpu_share'], p['cpu_share']))
+            p['ratio_range'][0], p['ratio_range'][1], r['pfv_over_yade_first'], r['pfv_over_yade_range'][0],
+            r['pfv_over_yade_range'][1], y['cpu_share'], p['cpu_share']))
     w('')
     w('PFV, first step / forced remesh, by stage (medians; `remesh_times()`; the time-step guard from '
       '`collective_viscous_history`: the certified bound, and the collective limit itself where the bound '
@@ -1427,11 +1435,26 @@ def report_only(opts):
     return 0
 
 
+def startup_report_only(opts):
+    """The start-up report of an earlier --startup run, from its JSON (--json), written to --out. The load average
+    at the end of each thread count's child is the one the child recorded."""
+    with open(opts['json']) as f:
+        data = json.load(f)
+    run = parse_args(data['command'].split()[4:])
+    machine, texts = data['machine'], []
+    for t, child in sorted(data['timing'].items(), key=lambda kv: int(kv[0])):
+        machine['load average at end'] = ' '.join('%.2f' % x for x in child['load_end'])
+        texts.append(startup_report(run, machine, startup_summary(child), data['command'], int(t)))
+    write_report(opts['out'], '\n\n'.join(texts), STARTUP_BEGIN_MARK, STARTUP_END_MARK)
+    log('start-up report of %s written to %s' % (opts['json'], opts['out']))
+    return 0
+
+
 def main(argv):
     opts = parse_args(argv)
     child = opts['child']
     if opts['report_only']:
-        return report_only(opts)
+        return startup_report_only(opts) if opts['startup'] else report_only(opts)
     if child is None:
         return startup_driver(opts, argv) if opts['startup'] else driver(opts, argv)
     try:

@@ -677,15 +677,13 @@ def startup_summary(data):
                 parts.setdefault('factor nonzeros', []).append((x['factor_nonzeros'], x['factor_nonzeros']))
             pair_medians = {k: v[0] if k == 'methods' else (median([a for a, _ in v]), median([b for _, b in v]))
                             for k, v in parts.items()}
-            row[kind] = dict(first=median(first), remesh=median(remesh), ratio=median(ratio),
+            row[kind] = dict(first=median(first), remesh=median(remesh), ratio=median(ratio), first_per_round=first,
                              first_range=(min(first), max(first)), ratio_range=(min(ratio), max(ratio)),
                              cpu_share=median(cpu),
                              parts=pair_medians)
         row['pfv_over_yade_first'] = row['pfv']['first'] / row['yade']['first']
         # Per round: the two engines' trials of one round ran next to each other, at the same machine speed.
-        per_round = [_window_cost(p['first'], median(p['steady']['exec'])) /
-                     _window_cost(y['first'], median(y['steady']['exec']))
-                     for y, p in zip(d['trials']['yade'], d['trials']['pfv'])]
+        per_round = [p / y for y, p in zip(row['yade']['first_per_round'], row['pfv']['first_per_round'])]
         row['pfv_over_yade_range'] = (min(per_round), max(per_round))
         rows[n] = row
     return rows

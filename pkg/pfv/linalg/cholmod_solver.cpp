@@ -1,9 +1,6 @@
 #include "pfv/linalg/cholmod_solver.hpp"
 
 #include <suitesparse/cholmod.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include <algorithm>
 #include <chrono>
@@ -16,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "pfv/common/parallel.hpp"
 #include "pfv/linalg/serial_openmp.hpp"
 #include "pfv/model/pressure_system.hpp"
 
@@ -366,11 +364,7 @@ void CholmodSolver::plan_substitution(const PressureSystem& system, double min_s
 }
 
 void CholmodSolver::solve(const std::vector<double>& rhs, std::vector<double>& x) {
-#ifdef _OPENMP
-  solve_on(rhs, x, omp_get_max_threads() > 1);
-#else
-  solve_on(rhs, x, false);
-#endif
+  solve_on(rhs, x, max_threads() > 1);
 }
 
 void CholmodSolver::solve_serial(const std::vector<double>& rhs, std::vector<double>& x) { solve_on(rhs, x, false); }

@@ -13,11 +13,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pfv/common/parallel.hpp"
 #include "pfv/model/pressure_system.hpp"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace pfv {
 
@@ -175,7 +172,7 @@ class Dissection {
   // first, until there are a few parts per OpenMP thread; the parts' subtrees are then split
   // in parallel, depth first.
   void run() {
-    const int threads = omp_max_threads();
+    const int threads = max_threads();
     Splitter first(*this);
     std::vector<Part> parts{{0, static_cast<int>(order_.size()), 0}};
     if (threads == 1) {
@@ -212,14 +209,6 @@ class Dissection {
   struct Part {
     int begin, end, depth;
   };
-
-  static int omp_max_threads() {
-#ifdef _OPENMP
-    return omp_get_max_threads();
-#else
-    return 1;
-#endif
-  }
 
   // One thread's splitting of parts, with its scratch.
   class Splitter {

@@ -6,7 +6,7 @@ The 1000-sphere permeameter, pressure 1 on ymin, 0 on ymax, spheres free to move
   * the default is solver='auto', which picks CHOLMOD here and says so in core.solver_choice;
     useSolver reads 3 for it;
   * solver='multigrid' gives the pressures of CHOLMOD within its promise, refinement_tolerance x (max p - min p),
-    at every one of 20 DEM steps across remeshes, with either multigrid_smoother; the outflux and the balance of
+    at every one of 20 DEM steps across remeshes, with each multigrid_smoother; the outflux and the balance of
     wall fluxes against the volume rates within what that promise implies (an error e in the pressures of the
     cells next to a pressure wall moves its flux by at most max|e| x the sum of those throats' conductances), and
     the force on a sphere to 1e-7;
@@ -87,6 +87,9 @@ against_direct("multigrid", multigrid, direct, flow.core.refinement_tolerance)
 flow, jacobi = history(solver="multigrid", multigrid_smoother="jacobi")
 rb.check("multigrid_smoother='jacobi' is set", flow.multigrid_smoother == "jacobi")
 against_direct("multigrid, Jacobi smoothing", jacobi, direct, flow.core.refinement_tolerance)
+flow, split = history(solver="multigrid", multigrid_smoother="split_gauss_seidel")
+rb.check("multigrid_smoother='split_gauss_seidel' is set", flow.multigrid_smoother == "split_gauss_seidel")
+against_direct("multigrid, split Gauss-Seidel smoothing", split, direct, flow.core.refinement_tolerance)
 
 O.reset()
 flow = rb.fresh()

@@ -26,7 +26,8 @@ struct EngineSettings {
   double max_factor_bytes = 0;
   // Multigrid (named or chosen by kAuto): the V-cycle's smoother. Jacobi costs less per step
   // where the start stays exact for many steps (a fixed skeleton), Gauss-Seidel where it is
-  // close but not exact (doc/solvers.md). A change rebuilds the hierarchy.
+  // close but not exact; the split Gauss-Seidel sweeps make an iteration cheaper than the
+  // symmetric pair for a few more iterations (doc/solvers.md). A change rebuilds the hierarchy.
   MultigridSmoother multigrid_smoother = MultigridSmoother::kGaussSeidel;
   double tolerance = 1e-6;  // Gauss-Seidel, incomplete-Cholesky CG
   double relax = 1.9;       // Gauss-Seidel

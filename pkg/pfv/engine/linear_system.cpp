@@ -253,6 +253,10 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
       if (automatic && l.choice.empty()) l.choice = "multigrid: kept from the previous mesh";
       AmgParameters parameters;
       if (settings.multigrid_smoother == MultigridSmoother::kJacobi) parameters.relax_type = 18;
+      if (settings.multigrid_smoother == MultigridSmoother::kSplitGaussSeidel) {
+        parameters.relax_down = 13;  // l1-scaled Gauss-Seidel, forwards
+        parameters.relax_up = 14;    // and backwards: the adjoint, so the cycle stays symmetric
+      }
       amg->setup(s, parameters);
     }
   }

@@ -18,4 +18,16 @@ std::string_view to_string(SolverKind kind) {
   return "unknown";
 }
 
+std::string_view to_string(MultigridSmoother smoother) {
+  switch (smoother) {
+    case MultigridSmoother::kGaussSeidel:
+      return "gauss_seidel";
+    case MultigridSmoother::kJacobi:
+      return "jacobi";
+    case MultigridSmoother::kSplitGaussSeidel:
+      return "split_gauss_seidel";
+  }
+  return "unknown";
+}
+
 }  // namespace pfv

@@ -18,9 +18,14 @@ struct PressureSystem;
 
 enum class SolverKind { kGaussSeidel, kConjugateGradient, kCholesky, kMultigrid, kAuto };
 
-// The smoother of the multigrid V-cycle (amg_pcg.hpp: hypre's symmetric l1-Gauss-Seidel sweeps,
-// or its l1-scaled Jacobi).
-enum class MultigridSmoother { kGaussSeidel, kJacobi };
+// The smoother of the multigrid V-cycle (amg_pcg.hpp): hypre's symmetric l1-Gauss-Seidel sweep
+// pair on the way down and up; its l1-scaled Jacobi; or kSplitGaussSeidel, one forward
+// Gauss-Seidel sweep on the way down and one backward sweep on the way up (the cycle stays
+// symmetric, with half the sweeps of kGaussSeidel).
+enum class MultigridSmoother { kGaussSeidel, kJacobi, kSplitGaussSeidel };
+
+// The smoother's name in the Python API: gauss_seidel, jacobi, split_gauss_seidel.
+std::string_view to_string(MultigridSmoother smoother);
 
 std::string_view to_string(SolverKind kind);
 

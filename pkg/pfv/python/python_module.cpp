@@ -203,18 +203,19 @@ PYBIND11_MODULE(_core, m) {
                     set_setting(&EngineSettings::max_factor_bytes),
                     "The largest Cholesky factor solver='auto' accepts (0: half the available memory).")
       .def_property(
-          "multigrid_smoother", exclusive([](const SharedEngine& e) {
-            return std::string(e.settings.multigrid_smoother == MultigridSmoother::kJacobi ? "jacobi" : "gauss_seidel");
-          }),
+          "multigrid_smoother",
+          exclusive([](const SharedEngine& e) { return std::string(to_string(e.settings.multigrid_smoother)); }),
           exclusive([](SharedEngine& e, const std::string& v) {
-            if (v != "jacobi" && v != "gauss_seidel")
-              throw py::value_error("multigrid_smoother must be one of jacobi, gauss_seidel; got '" + v + "'");
-            update(e, [&](EngineSettings& s) {
-              s.multigrid_smoother = v == "jacobi" ? MultigridSmoother::kJacobi : MultigridSmoother::kGaussSeidel;
-            });
+            const MultigridSmoother kinds[] = {MultigridSmoother::kGaussSeidel, MultigridSmoother::kJacobi,
+                                               MultigridSmoother::kSplitGaussSeidel};
+            for (MultigridSmoother k : kinds)
+              if (v == to_string(k)) return update(e, [&](EngineSettings& s) { s.multigrid_smoother = k; });
+            throw py::value_error("multigrid_smoother must be one of gauss_seidel, jacobi, split_gauss_seidel; got '" +
+                                  v + "'");
           }),
-          "The multigrid V-cycle's smoother: gauss_seidel (default; symmetric l1-scaled sweeps) or jacobi "
-          "(l1-scaled; cheaper for a fixed skeleton); rebuilds the hierarchy at the next step.")
+          "The multigrid V-cycle's smoother: gauss_seidel (default; symmetric l1-scaled sweeps on the way down and "
+          "up), jacobi (l1-scaled; cheaper for a fixed skeleton) or split_gauss_seidel (one forward sweep down, one "
+          "backward sweep up); rebuilds the hierarchy at the next step.")
       .def_property_readonly("solver_choice", exclusive([](const SharedEngine& e) { return e.solver_choice(); }),
                              "The current system's solver and why; empty before the first step.")
       .def_property("tolerance", get_setting(&EngineSettings::tolerance), set_setting(&EngineSettings::tolerance))

@@ -13,6 +13,8 @@
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/linalg/amg_pcg.hpp"
 #include "pfv/linalg/amg_solver.hpp"
+#include "pfv/linalg/cholesky_solver.hpp"
+#include "pfv/linalg/refinement.hpp"
 #include "pfv/model/pressure_system.hpp"
 #include "test_packings.hpp"
 
@@ -236,6 +238,61 @@ TEST(Multigrid, SolveToResidualIsTheInverse) {
   for (int i = 0; i < s.n_unknowns(); ++i) EXPECT_NEAR(x[i], y[i], 1e-7 * std::abs(scale));
   EXPECT_GT(amg.hierarchy()->levels(), 1);
   EXPECT_GT(amg.hierarchy()->operator_complexity(), 1);
+}
+
+// A factor beyond what CHOLMOD's 32-bit indices address (2^31 - 1 values; about a million
+// spheres) is refused like one beyond the budget, whatever the memory: the solver is left as
+// after release() and factorises a smaller system afterwards.
+TEST(Multigrid, AFactorBeyondTheIndexRangeIsRefused) {
+  const PressureSystem s = test::permeameter_system(400, 6);
+  CholeskySolver solver;
+  FactorOptions options;
+  options.index_range = 1000;  // in place of 2^31 - 1: this system's factor exceeds it
+  try {
+    solver.setup(s, options);
+    FAIL() << "a factor beyond the index range was accepted";
+  } catch (const FactorTooLarge& e) {
+    EXPECT_EQ(e.why, FactorLimit::kIndexRange);
+    EXPECT_GT(e.entries, 1000);
+    EXPECT_EQ(e.limit, 1000);
+    EXPECT_NE(std::string(e.what()).find("32-bit indices"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(solver.ready());
+  solver.setup(s, FactorOptions{});
+  ASSERT_TRUE(solver.ready());
+  std::vector<double> b(s.n_unknowns(), 1.0), x;
+  solver.solve(s, b, x, SolveControl{});
+  std::vector<double> r;
+  residual(s, b, x, r);
+  for (double v : r) EXPECT_LT(std::abs(v), 1e-9);
+}
+
+// A named Cholesky solver never runs out of memory silently: a factor beyond max_factor_bytes
+// (by default, the memory available) is refused with an error that names the alternatives, and
+// the engine then runs with another solver.
+TEST(Multigrid, ANamedCholeskyBeyondItsBoundSaysSo) {
+  const auto p = jittered_lattice(12, 9);
+  FlowEngine e = test::permeameter(0);
+  e.settings.solver = SolverKind::kCholesky;
+  e.settings.max_factor_bytes = 1e4;
+  try {
+    e.step(p.centre, p.radius, p.walls, 1e-3);
+    FAIL() << "a factor beyond max_factor_bytes was computed";
+  } catch (const std::runtime_error& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("solver='cholesky': the Cholesky factor would store"), std::string::npos) << what;
+    EXPECT_NE(what.find("max_factor_bytes"), std::string::npos) << what;
+    EXPECT_NE(what.find("solver='multigrid'"), std::string::npos) << what;
+  }
+  e.settings.solver = SolverKind::kMultigrid;
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(e.pressure_solver()->kind(), SolverKind::kMultigrid);
+  EXPECT_TRUE(e.last_solve().converged);
+  e.settings.solver = SolverKind::kCholesky;  // within the bound again: the factor is taken
+  e.settings.max_factor_bytes = 0;
+  e.request_remesh();
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(e.pressure_solver()->kind(), SolverKind::kCholesky);
 }
 
 TEST(Multigrid, AutoTakesTheFactorUnlessItExceedsTheBudget) {

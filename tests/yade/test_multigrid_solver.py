@@ -10,7 +10,8 @@ The 1000-sphere permeameter, pressure 1 on ymin, 0 on ymax, spheres free to move
     wall fluxes against the volume rates within what that promise implies (an error e in the pressures of the
     cells next to a pressure wall moves its flux by at most max|e| x the sum of those throats' conductances), and
     the force on a sphere to 1e-7;
-  * max_factor_bytes below this factor makes 'auto' choose multigrid and report why;
+  * max_factor_bytes below this factor makes 'auto' choose multigrid and report why, and a named 'cholesky' raise
+    RuntimeError saying so (the engine then runs with multigrid);
   * an unknown solver or smoother name and a negative max_factor_bytes raise ValueError naming the setting,
     and the engine still runs afterwards.
 """
@@ -105,6 +106,16 @@ rb.run(1)
 rb.check("auto picks multigrid beyond max_factor_bytes",
          flow.core.solver_choice.startswith("multigrid: the Cholesky factor would store"), flow.core.solver_choice)
 q = flow.getBoundaryFlux(3)
+
+O.reset()
+flow = rb.fresh(solver="cholesky", max_factor_bytes=1e4)
+rb.expect_error("a named cholesky beyond max_factor_bytes", RuntimeError,
+                "solver='cholesky': the Cholesky factor would store", rb.run)
+flow.solver = "multigrid"
+rb.run(1)
+rb.check("after the refusal the engine runs on with another solver",
+         flow.core.solver_choice == "multigrid: as set" and abs(flow.getBoundaryFlux(3) - q) <= 1e-8 * abs(q),
+         f"{flow.core.solver_choice}; outflux {flow.getBoundaryFlux(3):.9e} against {q:.9e}")
 
 O.reset()
 flow = rb.fresh()

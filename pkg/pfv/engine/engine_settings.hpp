@@ -22,7 +22,9 @@ struct EngineSettings {
   SolverKind solver = SolverKind::kAuto;
   // The largest Cholesky factor kAuto accepts, in bytes (8 per stored value: factorised in
   // double); 0: half the memory available (MemAvailable) when the system is built, plus the
-  // storage of the factor it replaces.
+  // storage of the factor it replaces. A named kCholesky refuses a larger factor with an error
+  // (0: all the memory available), and either refuses one beyond the 2^31 - 1 values CHOLMOD's
+  // 32-bit indices address (FactorLimit::kIndexRange).
   double max_factor_bytes = 0;
   // Multigrid (named or chosen by kAuto): the V-cycle's smoother. Jacobi costs less per step
   // where the start stays exact for many steps (a fixed skeleton), Gauss-Seidel where it is

@@ -87,11 +87,13 @@ double memory_available() {
   return 0;
 }
 
-// The bound on the values of a Cholesky factor under SolverKind::kAuto.
+// The bound on the values of a Cholesky factor: under SolverKind::kAuto, the size beyond which it
+// takes multigrid (half the memory available, by default); for a named Cholesky solver, beyond
+// which the factor is refused with an error (all of it: such a factor could not be stored).
 double factor_entry_budget(const EngineSettings& s, const PressureSolver* recycled) {
   double bytes = s.max_factor_bytes;
   if (bytes == 0) {
-    bytes = 0.5 * memory_available();
+    bytes = (s.solver == SolverKind::kAuto ? 0.5 : 1.0) * memory_available();
     if (const auto* c = dynamic_cast<const CholeskySolver*>(recycled))
       bytes += static_cast<double>(c->factor().value_capacity()) * sizeof(double);  // reused, not new
     if (bytes == 0) return std::numeric_limits<double>::infinity();                 // no /proc: no bound
@@ -107,6 +109,20 @@ std::string bytes_text(double bytes) {
   else
     std::snprintf(text, sizeof text, "%.4g MB", bytes / 1e6);
   return text;
+}
+
+// "the Cholesky factor would store ..., more than ...": why a factor was refused.
+std::string refusal_text(const FactorTooLarge& e, const EngineSettings& s) {
+  if (e.why == FactorLimit::kIndexRange) {
+    char values[32];
+    std::snprintf(values, sizeof values, "%.3g", e.entries);
+    return std::string("the Cholesky factor would store at least ") + values +
+           " values, more than the 2^31 - 1 that CHOLMOD's 32-bit indices address";
+  }
+  const std::string limit = s.solver == SolverKind::kAuto ? "the budget of " + bytes_text(e.limit * 8)
+                            : s.max_factor_bytes > 0      ? "max_factor_bytes = " + bytes_text(e.limit * 8)
+                                                          : "the " + bytes_text(e.limit * 8) + " of memory available";
+  return "the Cholesky factor would store " + bytes_text(e.entries * 8) + ", more than " + limit;
 }
 
 }  // namespace
@@ -164,7 +180,8 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   const bool keep =
       recycled && (recycled->kind() == settings.solver || (automatic && (recycled->kind() == SolverKind::kCholesky ||
                                                                          recycled->kind() == SolverKind::kMultigrid)));
-  const double budget = automatic ? factor_entry_budget(settings, recycled.get()) : 0;
+  const bool factor = automatic || settings.solver == SolverKind::kCholesky;
+  const double budget = factor ? factor_entry_budget(settings, recycled.get()) : 0;
   l.solver = keep ? std::move(recycled) : make_solver(settings.solver);
   if (settings.fluid_bulk_modulus > 0) {
     const int nc = m.mesh().n_cells();
@@ -225,15 +242,17 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
           }
           return geometric_ordering(s, point);
         };
-      if (automatic) options.max_entries = budget;
+      options.max_entries = budget;
       try {
         cholesky->setup(s, options);
         if (automatic)
           l.choice = "cholesky: the factor stores " + bytes_text(cholesky->factor().factor_nonzeros() * 8) +
                      ", within the budget of " + bytes_text(budget * 8);
       } catch (const FactorTooLarge& e) {
-        l.choice = "multigrid: the Cholesky factor would store " + bytes_text(e.entries * 8) +
-                   ", more than the budget of " + bytes_text(budget * 8);
+        if (!automatic)
+          throw std::runtime_error("solver='cholesky': " + refusal_text(e, settings) +
+                                   "; use solver='multigrid' (or 'auto', which takes it when the factor does not fit)");
+        l.choice = "multigrid: " + refusal_text(e, settings);
         l.solver = std::make_unique<AmgSolver>();
         l.times.analysis = seconds_since(t0);
       }

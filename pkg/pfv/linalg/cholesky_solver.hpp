@@ -20,12 +20,13 @@ struct FactorOptions {
   bool openmp_teams = false;      // EngineSettings::cholmod_openmp_teams
   // setup() throws FactorTooLarge, having spent only the analysis, beyond this many values.
   double max_entries = std::numeric_limits<double>::infinity();
+  double index_range = CholmodSolver::kIndexRange;  // CholmodSolver::set_index_range
 };
 
 class CholeskySolver final : public PressureSolver {
  public:
   // Throws std::domain_error if G is not positive definite, FactorTooLarge (cholmod_solver.hpp)
-  // beyond options.max_entries.
+  // beyond options.max_entries or options.index_range.
   void setup(const PressureSystem& system, const FactorOptions& options);
   SolverKind kind() const override { return SolverKind::kCholesky; }
   bool ready() const override { return factor_.ready(); }

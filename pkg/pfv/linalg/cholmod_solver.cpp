@@ -156,11 +156,14 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     }
   }
   analysis_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!f && c->status == CHOLMOD_TOO_LARGE)  // c->lnz: the column counts', fewer than the supernodes store
+    throw FactorTooLarge(std::max(c->lnz, index_range_), index_range_, FactorLimit::kIndexRange);
   if (!f) throw std::runtime_error("CHOLMOD analysis failed (status " + std::to_string(c->status) + ")");
-  if (static_cast<double>(f->xsize) > max_entries_) {
-    const double stored = static_cast<double>(f->xsize);
+  const double stored = static_cast<double>(f->xsize);
+  if (stored > index_range_ || stored > max_entries_) {
     cholmod_free_factor(&f, c);
-    throw FactorTooLarge(stored, max_entries_);
+    if (stored > index_range_) throw FactorTooLarge(stored, index_range_, FactorLimit::kIndexRange);
+    throw FactorTooLarge(stored, max_entries_, FactorLimit::kBudget);
   }
   factor_ = f;
   lend_values(f);
@@ -169,10 +172,13 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
   plan_substitution(s, precision == FactorPrecision::kScaled32 ? min_scaled_entries : kNever);
 }
 
-FactorTooLarge::FactorTooLarge(double stored, double limit)
+FactorTooLarge::FactorTooLarge(double stored, double limit, FactorLimit why)
     : std::runtime_error("the Cholesky factor would store " + std::to_string(stored) + " values, more than " +
-                         std::to_string(limit)),
-      entries(stored) {}
+                         std::to_string(limit) +
+                         (why == FactorLimit::kIndexRange ? " (what CHOLMOD's 32-bit indices address)" : "")),
+      entries(stored),
+      limit(limit),
+      why(why) {}
 
 void CholmodSolver::FreeValues::operator()(double* p) const { std::free(p); }
 

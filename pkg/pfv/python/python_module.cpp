@@ -201,7 +201,8 @@ PYBIND11_MODULE(_core, m) {
                     "auto (default): the Cholesky factor unless it would exceed max_factor_bytes, then multigrid.")
       .def_property("max_factor_bytes", get_setting(&EngineSettings::max_factor_bytes),
                     set_setting(&EngineSettings::max_factor_bytes),
-                    "The largest Cholesky factor solver='auto' accepts (0: half the available memory).")
+                    "The largest Cholesky factor solver='auto' accepts (0: half the available memory); with "
+                    "solver='cholesky' a larger factor raises RuntimeError (0: all the available memory).")
       .def_property(
           "multigrid_smoother",
           exclusive([](const SharedEngine& e) { return std::string(to_string(e.settings.multigrid_smoother)); }),

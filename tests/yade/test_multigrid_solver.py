@@ -10,13 +10,15 @@ The 1000-sphere permeameter, pressure 1 on ymin, 0 on ymax, spheres free to move
     wall fluxes against the volume rates within what that promise implies (an error e in the pressures of the
     cells next to a pressure wall moves its flux by at most max|e| x the sum of those throats' conductances), and
     the force on a sphere to 1e-7;
-  * max_factor_bytes below this factor makes 'auto' choose multigrid and report why, and a named 'cholesky' raise
+  * max_factor_bytes below this factor makes 'auto' choose multigrid and report why (solver_choice, and one
+    warning), and a named 'cholesky' raise
     RuntimeError saying so (the engine then runs with multigrid);
   * an unknown solver or smoother name and a negative max_factor_bytes raise ValueError naming the setting,
     and the engine still runs afterwards.
 """
 import os
 import sys
+import warnings
 
 HERE = os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].endswith('.py') else __file__))
 sys.path.insert(0, HERE)
@@ -102,9 +104,14 @@ rb.check("auto picks CHOLMOD for a small packing", flow.core.solver_choice.start
 
 O.reset()
 flow = rb.fresh(max_factor_bytes=1e4)
-rb.run(1)
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    rb.run(2)
 rb.check("auto picks multigrid beyond max_factor_bytes",
          flow.core.solver_choice.startswith("multigrid: the Cholesky factor would store"), flow.core.solver_choice)
+said = [str(w.message) for w in caught if "solver='auto' solves by multigrid" in str(w.message)]
+rb.check("auto says once, in a warning, that it took multigrid and why",
+         len(said) == 1 and "would store" in said[0] and "more than the budget of 0.01 MB" in said[0], "; ".join(said))
 q = flow.getBoundaryFlux(3)
 
 O.reset()

@@ -401,6 +401,13 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
                           "remesh that pore cells were turned inside out; remeshed (and will again whenever "
                           "this happens). Lower meshUpdateInterval or defTolerance for motion this fast",
                           stacklevel=2)
+        if "auto multigrid" not in self._warned and core.solver == "auto":
+            choice = core.solver_choice
+            if choice.startswith("multigrid: the Cholesky"):  # not "kept from the previous mesh"
+                self._warned.add("auto multigrid")
+                warnings.warn(f"pfv.FlowEngine: solver='auto' solves by multigrid from iteration {scene.iter}: "
+                              f"{choice[len('multigrid: '):]}. Set solver='multigrid' to skip the Cholesky "
+                              "analysis at the start, or max_factor_bytes to move the bound", stacklevel=2)
         if remeshing or core.inversion_remeshes != inversions:
             hidden = core.hidden_spheres()
             if hidden:

@@ -8,7 +8,8 @@ turn, one fresh engine in a fresh process (so that no engine runs in memory anot
 its first step, the stages of its first mesh (`remesh_times()`), the first
 solve (`step_times()`), and the engine's report of its choice (`solver_choice`). Under `solver="auto"` the
 "analysis" stage is the fill-reducing ordering and CHOLMOD's symbolic factorisation that project the factor's size
-against the budget (half the available memory), which it pays whichever solver it then takes. No timing is asserted.
+against the budget (half the available memory) and against CHOLMOD's 32-bit index range, which it pays whichever
+solver it then takes. No timing is asserted.
 """
 import os
 import subprocess

@@ -13,8 +13,6 @@
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/linalg/amg_pcg.hpp"
 #include "pfv/linalg/amg_solver.hpp"
-#include "pfv/linalg/cholesky_solver.hpp"
-#include "pfv/linalg/refinement.hpp"
 #include "pfv/model/pressure_system.hpp"
 #include "test_packings.hpp"
 
@@ -63,6 +61,14 @@ void expect_multigrid_matches_direct(const test::TestPacking& p, int steps,
     direct.step(x, p.radius, p.walls, dt);
     multigrid.step(x, p.radius, p.walls, dt);
     ASSERT_EQ(multigrid.pressure_solver()->kind(), SolverKind::kMultigrid);
+    if (step == 0) {  // the smoother asked for is the one hypre set up (down, up the V-cycle)
+      const auto* amg = dynamic_cast<const AmgSolver*>(multigrid.pressure_solver());
+      ASSERT_TRUE(amg && amg->hierarchy());
+      const std::array<int, 2> expected = smoother == MultigridSmoother::kJacobi             ? std::array{18, 18}
+                                          : smoother == MultigridSmoother::kSplitGaussSeidel ? std::array{13, 14}
+                                                                                             : std::array{8, 8};
+      EXPECT_EQ(amg->hierarchy()->cycle_relax_types(), expected);
+    }
     ASSERT_TRUE(multigrid.last_solve().converged) << "step " << step;
     EXPECT_GT(multigrid.last_solve().cg_iterations, 0);
     const std::vector<double>& ref = direct.pressure();
@@ -240,59 +246,40 @@ TEST(Multigrid, SolveToResidualIsTheInverse) {
   EXPECT_GT(amg.hierarchy()->operator_complexity(), 1);
 }
 
-// A factor beyond what CHOLMOD's 32-bit indices address (2^31 - 1 values; about a million
-// spheres) is refused like one beyond the budget, whatever the memory: the solver is left as
-// after release() and factorises a smaller system afterwards.
-TEST(Multigrid, AFactorBeyondTheIndexRangeIsRefused) {
-  const PressureSystem s = test::permeameter_system(400, 6);
-  CholeskySolver solver;
-  FactorOptions options;
-  options.index_range = 1000;  // in place of 2^31 - 1: this system's factor exceeds it
-  try {
-    solver.setup(s, options);
-    FAIL() << "a factor beyond the index range was accepted";
-  } catch (const FactorTooLarge& e) {
-    EXPECT_EQ(e.why, FactorLimit::kIndexRange);
-    EXPECT_GT(e.entries, 1000);
-    EXPECT_EQ(e.limit, 1000);
-    EXPECT_NE(std::string(e.what()).find("32-bit indices"), std::string::npos) << e.what();
-  }
-  EXPECT_FALSE(solver.ready());
-  solver.setup(s, FactorOptions{});
-  ASSERT_TRUE(solver.ready());
-  std::vector<double> b(s.n_unknowns(), 1.0), x;
-  solver.solve(s, b, x, SolveControl{});
-  std::vector<double> r;
-  residual(s, b, x, r);
-  for (double v : r) EXPECT_LT(std::abs(v), 1e-9);
-}
-
-// A named Cholesky solver never runs out of memory silently: a factor beyond max_factor_bytes
-// (by default, the memory available) is refused with an error that names the alternatives, and
-// the engine then runs with another solver.
+// A named Cholesky solver does not start a factor whose values alone exceed max_factor_bytes (by
+// default, the memory available): the step raises an error that names the alternatives, on the
+// first mesh as on a later one, and the engine runs on once the solver or the bound is changed.
 TEST(Multigrid, ANamedCholeskyBeyondItsBoundSaysSo) {
   const auto p = jittered_lattice(12, 9);
+  const auto expect_refusal = [](FlowEngine& e, const test::TestPacking& q) {
+    try {
+      e.step(q.centre, q.radius, q.walls, 1e-3);
+      ADD_FAILURE() << "a factor beyond max_factor_bytes was computed";
+    } catch (const std::runtime_error& error) {
+      const std::string what = error.what();
+      EXPECT_NE(what.find("solver='cholesky': the Cholesky factor would store"), std::string::npos) << what;
+      EXPECT_NE(what.find("max_factor_bytes"), std::string::npos) << what;
+      EXPECT_NE(what.find("solver='multigrid'"), std::string::npos) << what;
+    }
+  };
   FlowEngine e = test::permeameter(0);
   e.settings.solver = SolverKind::kCholesky;
   e.settings.max_factor_bytes = 1e4;
-  try {
-    e.step(p.centre, p.radius, p.walls, 1e-3);
-    FAIL() << "a factor beyond max_factor_bytes was computed";
-  } catch (const std::runtime_error& error) {
-    const std::string what = error.what();
-    EXPECT_NE(what.find("solver='cholesky': the Cholesky factor would store"), std::string::npos) << what;
-    EXPECT_NE(what.find("max_factor_bytes"), std::string::npos) << what;
-    EXPECT_NE(what.find("solver='multigrid'"), std::string::npos) << what;
-  }
-  e.settings.solver = SolverKind::kMultigrid;
+  expect_refusal(e, p);
+  e.settings.solver = SolverKind::kMultigrid;  // another solver
   e.step(p.centre, p.radius, p.walls, 1e-3);
   EXPECT_EQ(e.pressure_solver()->kind(), SolverKind::kMultigrid);
   EXPECT_TRUE(e.last_solve().converged);
-  e.settings.solver = SolverKind::kCholesky;  // within the bound again: the factor is taken
-  e.settings.max_factor_bytes = 0;
+  const std::vector<double> multigrid = e.pressure();
+  e.settings.solver = SolverKind::kCholesky;  // refused again, at a remesh
   e.request_remesh();
+  expect_refusal(e, p);
+  e.settings.max_factor_bytes = 0;  // the bound raised: the next step factorises
   e.step(p.centre, p.radius, p.walls, 1e-3);
-  EXPECT_EQ(e.pressure_solver()->kind(), SolverKind::kCholesky);
+  ASSERT_EQ(e.pressure_solver()->kind(), SolverKind::kCholesky);
+  const double s = spread(e.pressure());
+  for (std::size_t c = 0; c < e.pressure().size(); ++c)
+    EXPECT_NEAR(multigrid[c], e.pressure()[c], 2 * e.settings.refinement_tolerance * s);
 }
 
 TEST(Multigrid, AutoTakesTheFactorUnlessItExceedsTheBudget) {
@@ -318,4 +305,9 @@ TEST(Multigrid, AutoTakesTheFactorUnlessItExceedsTheBudget) {
   EXPECT_EQ(tight.pressure_solver()->kind(), SolverKind::kMultigrid);
   EXPECT_EQ(tight.solver_choice(), "multigrid: kept from the previous mesh");
   EXPECT_LT(tight.last_solve().cg_iterations, cold_iterations);
+  // A new bound makes the choice again, without a remesh.
+  tight.settings.max_factor_bytes = 0;
+  tight.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(tight.pressure_solver()->kind(), SolverKind::kCholesky);
+  EXPECT_EQ(tight.solver_choice().rfind("cholesky: the factor stores", 0), 0u) << tight.solver_choice();
 }

@@ -11,8 +11,7 @@ The 1000-sphere permeameter, pressure 1 on ymin, 0 on ymax, spheres free to move
     cells next to a pressure wall moves its flux by at most max|e| x the sum of those throats' conductances), and
     the force on a sphere to 1e-7;
   * max_factor_bytes below this factor makes 'auto' choose multigrid and report why (solver_choice, and one
-    warning), and a named 'cholesky' raise
-    RuntimeError saying so (the engine then runs with multigrid);
+    warning), and a named 'cholesky' raise RuntimeError saying so (the engine then runs with multigrid);
   * an unknown solver or smoother name and a negative max_factor_bytes raise ValueError naming the setting,
     and the engine still runs afterwards.
 """

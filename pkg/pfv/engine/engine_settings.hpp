@@ -18,13 +18,13 @@ struct EngineSettings {
   // formula alone, closer on regular packings.
   bool yade_wall_throat_factor = true;
   // kAuto: the Cholesky factor unless its analysis projects more stored values than fit in
-  // max_factor_bytes (linear_system.hpp), else multigrid.
+  // max_factor_bytes (linear_system.hpp) or than CHOLMOD's 32-bit indices address, else multigrid.
   SolverKind solver = SolverKind::kAuto;
   // The largest Cholesky factor kAuto accepts, in bytes (8 per stored value: factorised in
   // double); 0: half the memory available (MemAvailable) when the system is built, plus the
   // storage of the factor it replaces. A named kCholesky refuses a larger factor with an error
-  // (0: all the memory available), and either refuses one beyond the 2^31 - 1 values CHOLMOD's
-  // 32-bit indices address (FactorLimit::kIndexRange).
+  // (0: all the memory available), checked at each factorisation; both refuse a factor beyond
+  // the 2^31 - 1 values CHOLMOD's 32-bit indices address (FactorLimit::kIndexRange).
   double max_factor_bytes = 0;
   // Multigrid (named or chosen by kAuto): the V-cycle's smoother. Jacobi costs less per step
   // where the start stays exact for many steps (a fixed skeleton), Gauss-Seidel where it is

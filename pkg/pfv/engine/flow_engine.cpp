@@ -275,6 +275,11 @@ bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditio
 std::unique_ptr<PressureSolver> FlowEngine::released_solver() {
   auto solver = std::move(linear_.solver);
   if (solver) solver->release();
+  // Under kAuto a multigrid solver carried over keeps the choice (build_linear_system); a new
+  // max_factor_bytes asks for it again.
+  if (solver && settings.solver == SolverKind::kAuto && solver->kind() == SolverKind::kMultigrid &&
+      linear_.recipe.max_factor_bytes != settings.max_factor_bytes)
+    solver.reset();
   return solver;
 }
 

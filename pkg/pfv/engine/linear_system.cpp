@@ -89,14 +89,15 @@ double memory_available() {
 
 // The bound on the values of a Cholesky factor: under SolverKind::kAuto, the size beyond which it
 // takes multigrid (half the memory available, by default); for a named Cholesky solver, beyond
-// which the factor is refused with an error (all of it: such a factor could not be stored).
+// which the factor is refused with an error (all of it: values that alone could not be stored).
 double factor_entry_budget(const EngineSettings& s, const PressureSolver* recycled) {
   double bytes = s.max_factor_bytes;
   if (bytes == 0) {
-    bytes = (s.solver == SolverKind::kAuto ? 0.5 : 1.0) * memory_available();
+    const double available = memory_available();
+    if (available == 0) return std::numeric_limits<double>::infinity();  // not known: no bound
+    bytes = (s.solver == SolverKind::kAuto ? 0.5 : 1.0) * available;
     if (const auto* c = dynamic_cast<const CholeskySolver*>(recycled))
       bytes += static_cast<double>(c->factor().value_capacity()) * sizeof(double);  // reused, not new
-    if (bytes == 0) return std::numeric_limits<double>::infinity();                 // no /proc: no bound
   }
   return bytes / sizeof(double);
 }

@@ -29,7 +29,9 @@ struct SystemRecipe {
   Ordering ordering = Ordering::kAuto;  // Cholesky only
   bool mixed_precision = false;         // Cholesky only
   double mixed_precision_min_entries = 0;
-  double max_factor_bytes = 0;                                             // kAuto only
+  // kAuto: a new bound makes the choice again. A named Cholesky reads it at each factorisation
+  // only (a held factor is not given up for a lower bound, and a refused one leaves no solver).
+  double max_factor_bytes = 0;
   MultigridSmoother multigrid_smoother = MultigridSmoother::kGaussSeidel;  // kMultigrid, kAuto
   double fluid_bulk_modulus = 0;
   double minimum_porosity = 0;  // enters G only with a compressible fluid
@@ -80,7 +82,8 @@ struct CellState {
 };
 
 // Throws std::domain_error if the system is singular, std::invalid_argument if an imposed point
-// lies in no pore cell. previous: the ordering of the last
+// lies in no pore cell, std::runtime_error if a named Cholesky solver's factor exceeds its bound
+// (max_factor_bytes, else the memory available) or CHOLMOD's index range. previous: the ordering of the last
 // factorisation, tried first when settings.reuse_ordering (null: compute one). recycled: the
 // released solver of the previous system, reused (with the storage of its factor's values) if
 // it is of the kind the settings ask for.

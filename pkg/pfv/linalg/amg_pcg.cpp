@@ -217,6 +217,11 @@ AmgPcg::~AmgPcg() = default;
 
 int AmgPcg::levels() const { return hypre_ParAMGDataNumLevels(reinterpret_cast<hypre_ParAMGData*>(impl_->amg.get())); }
 
+std::array<int, 2> AmgPcg::cycle_relax_types() const {
+  const HYPRE_Int* type = hypre_ParAMGDataGridRelaxType(reinterpret_cast<hypre_ParAMGData*>(impl_->amg.get()));
+  return {static_cast<int>(type[1]), static_cast<int>(type[2])};  // [1] down, [2] up ([0] fine, [3] coarsest)
+}
+
 AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x, double tolerance,
                             int max_iterations) {
   Impl& m = *impl_;

@@ -25,6 +25,7 @@
 #pragma once
 #include <mpi.h>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -51,7 +52,9 @@ struct DistributedRows {
 // (18) reads each level's matrix half as often per iteration but needs more iterations, and
 // its slower contraction makes the stopping rule's first-iteration test more cautious: it costs
 // less per step where the start is exact for many steps (a fixed skeleton), more where the
-// start is close but not exact (doc/solvers.md, bench/multigrid_smoothers.py).
+// start is close but not exact. One forward sweep down and one backward sweep up (relax_down
+// 13, relax_up 14) also halves the sweeps, for about one more iteration (doc/solvers.md,
+// bench/multigrid_smoothers.py).
 struct AmgParameters {
   double strong_threshold = 0.5;
   int coarsen_type = 10;  // HMIS
@@ -94,6 +97,8 @@ class AmgPcg {
                                   int max_iterations) const;
 
   int levels() const;
+  // hypre's smoother (relax type) on the way down and on the way up the V-cycle, as set up.
+  std::array<int, 2> cycle_relax_types() const;
   // Entries of all levels' matrices over those of G (hypre's operator complexity).
   double operator_complexity() const { return operator_complexity_; }
 

@@ -8,7 +8,7 @@ void CholeskySolver::setup(const PressureSystem& system, const FactorOptions& op
   refinement_.reset();
   factor_.set_openmp_teams(options.openmp_teams);
   factor_.set_max_entries(options.max_entries);
-  factor_.set_index_range(options.index_range);
+  factor_.set_index_range_for_test(options.index_range);
   factor_.factorize(system, options.ordering, options.precision, options.given, options.min_scaled_entries);
 }
 

@@ -20,7 +20,7 @@ struct FactorOptions {
   bool openmp_teams = false;      // EngineSettings::cholmod_openmp_teams
   // setup() throws FactorTooLarge, having spent only the analysis, beyond this many values.
   double max_entries = std::numeric_limits<double>::infinity();
-  double index_range = CholmodSolver::kIndexRange;  // CholmodSolver::set_index_range
+  double index_range = CholmodSolver::kMaxIndexedValues;  // lowered by tests only (set_index_range_for_test)
 };
 
 class CholeskySolver final : public PressureSolver {

@@ -166,19 +166,32 @@ void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, Factor
     throw FactorTooLarge(stored, max_entries_, FactorLimit::kBudget);
   }
   factor_ = f;
-  lend_values(f);
-  numeric_factorization(s);
-  prefault_.stop();  // every page of the factor has been written
-  plan_substitution(s, precision == FactorPrecision::kScaled32 ? min_scaled_entries : kNever);
+  try {  // out of memory on the way: no half-made factor may look ready
+    lend_values(f);
+    numeric_factorization(s);
+    prefault_.stop();  // every page of the factor has been written
+    plan_substitution(s, precision == FactorPrecision::kScaled32 ? min_scaled_entries : kNever);
+  } catch (...) {
+    release();
+    throw;
+  }
 }
 
-FactorTooLarge::FactorTooLarge(double stored, double limit, FactorLimit why)
-    : std::runtime_error("the Cholesky factor would store " + std::to_string(stored) + " values, more than " +
-                         std::to_string(limit) +
-                         (why == FactorLimit::kIndexRange ? " (what CHOLMOD's 32-bit indices address)" : "")),
+namespace {
+std::string values_text(double values) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", values);
+  return text;
+}
+}  // namespace
+
+FactorTooLarge::FactorTooLarge(double stored, double bound, FactorLimit reason)
+    : std::runtime_error("the Cholesky factor would store " + values_text(stored) + " values, more than " +
+                         values_text(bound) +
+                         (reason == FactorLimit::kIndexRange ? " (what CHOLMOD's 32-bit indices address)" : "")),
       entries(stored),
-      limit(limit),
-      why(why) {}
+      limit(bound),
+      why(reason) {}
 
 void CholmodSolver::FreeValues::operator()(double* p) const { std::free(p); }
 

@@ -69,13 +69,13 @@ struct GivenOrdering {
 };
 
 // Which bound a factor exceeded: the caller's (set_max_entries), or the values CHOLMOD's 32-bit
-// indices can address (kIndexRange), which no amount of memory lifts.
+// indices can address (CholmodSolver::kMaxIndexedValues), which no amount of memory lifts.
 enum class FactorLimit { kBudget, kIndexRange };
 
 // Thrown by CholmodSolver::factorize when the analysed factor would store more values than
 // allowed: the solver is then as after release(), and no value was touched.
 struct FactorTooLarge : std::runtime_error {
-  FactorTooLarge(double stored, double limit, FactorLimit why);
+  FactorTooLarge(double stored, double bound, FactorLimit reason);
   double entries;  // values the supernodal factor would store (at least this many for kIndexRange)
   double limit;
   FactorLimit why;
@@ -109,10 +109,10 @@ class CholmodSolver {
   void set_max_entries(double entries) { max_entries_ = entries; }
   // CHOLMOD's int interface addresses at most 2^31 - 1 values (about 1 million spheres at the
   // benchmark packings' fill); its analysis of a larger factor fails with CHOLMOD_TOO_LARGE,
-  // which factorize() reports as FactorTooLarge(kIndexRange). A smaller range here makes a
-  // small factor exceed it, for tests of what callers do then.
-  static constexpr double kIndexRange = 2147483647.0;
-  void set_index_range(double entries) { index_range_ = entries; }
+  // which factorize() reports as FactorTooLarge(kIndexRange), as it does any analysed factor
+  // beyond index_range (this, unless lowered: a test hook, so that a small factor exceeds it).
+  static constexpr double kMaxIndexedValues = 2147483647.0;
+  void set_index_range_for_test(double entries) { index_range_ = entries; }
   // The same on the calling thread only (the same arithmetic, the same result).
   void solve_serial(const std::vector<double>& rhs, std::vector<double>& x);
   bool reduced_precision() const { return !scale_.empty(); }  // the kScaled32 format
@@ -152,7 +152,7 @@ class CholmodSolver {
   bool openmp_teams_ = false;
   SupernodalWorkspace numeric_work_;
   double max_entries_ = kNever;
-  double index_range_ = kIndexRange;
+  double index_range_ = kMaxIndexedValues;
   void* factor_ = nullptr;  // cholmod_factor*
   // The factor's numeric values, lent to CHOLMOD (which otherwise allocates them afresh at
   // every factorisation). A factor of tens of thousands of spheres takes hundreds of MB; glibc

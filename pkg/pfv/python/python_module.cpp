@@ -198,7 +198,8 @@ PYBIND11_MODULE(_core, m) {
                           "multigrid, auto; got '" +
                           v + "'");
                     }),
-                    "auto (default): the Cholesky factor unless it would exceed max_factor_bytes, then multigrid.")
+                    "auto (default): the Cholesky factor unless it would exceed max_factor_bytes or CHOLMOD's 32-bit "
+                    "index range, then multigrid.")
       .def_property("max_factor_bytes", get_setting(&EngineSettings::max_factor_bytes),
                     set_setting(&EngineSettings::max_factor_bytes),
                     "The largest Cholesky factor solver='auto' accepts (0: half the available memory); with "

@@ -405,9 +405,10 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
             choice = core.solver_choice
             if choice.startswith("multigrid: the Cholesky"):  # not "kept from the previous mesh"
                 self._warned.add("auto multigrid")
+                bound = ", or raise max_factor_bytes" if "budget" in choice else ""  # not CHOLMOD's index range
                 warnings.warn(f"pfv.FlowEngine: solver='auto' solves by multigrid from iteration {scene.iter}: "
                               f"{choice[len('multigrid: '):]}. Set solver='multigrid' to skip the Cholesky "
-                              "analysis at the start, or max_factor_bytes to move the bound", stacklevel=2)
+                              f"analysis at the start{bound}", stacklevel=2)
         if remeshing or core.inversion_remeshes != inversions:
             hidden = core.hidden_spheres()
             if hidden:

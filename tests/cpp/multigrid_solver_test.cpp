@@ -226,6 +226,26 @@ TEST(Multigrid, SplitGaussSeidelSmootherMatchesTheDirectSolve) {
   expect_multigrid_matches_direct(jittered_lattice(37, 4), 3, MultigridSmoother::kSplitGaussSeidel);
 }
 
+// A remesh in the background keeps auto's choice of multigrid as one in the foreground does,
+// without the ordering and analysis that made it.
+TEST(Multigrid, AutoKeepsMultigridAcrossBackgroundRemeshes) {
+  const auto p = jittered_lattice(12, 9);
+  FlowEngine e = test::permeameter(0);
+  e.settings.max_factor_bytes = 1e4;
+  e.settings.background_remesh = true;
+  e.settings.mesh_update_interval = 2;
+  e.step(p.centre, p.radius, p.walls, 1e-3);
+  ASSERT_EQ(e.pressure_solver()->kind(), SolverKind::kMultigrid);
+  for (int i = 0; i < 4; ++i) {
+    e.wait_for_remesh();
+    e.step(p.centre, p.radius, p.walls, 1e-3);
+  }
+  ASSERT_GE(e.remesh_count(), 2);  // background remeshes were adopted
+  EXPECT_EQ(e.pressure_solver()->kind(), SolverKind::kMultigrid);
+  EXPECT_EQ(e.solver_choice(), "multigrid: kept from the previous mesh");
+  EXPECT_EQ(e.system_times().analysis, 0);  // no ordering, no CHOLMOD analysis
+}
+
 TEST(Multigrid, SolveToResidualIsTheInverse) {
   const auto p = jittered_lattice(10, 8);
   FlowEngine e = test::permeameter(2);

@@ -10,6 +10,7 @@
 
 #include "pfv/common/parallel.hpp"
 #include "pfv/common/stage_timer.hpp"
+#include "pfv/linalg/amg_solver.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/model/cell_queries.hpp"
 #include "pfv/snapshot/snapshot.hpp"
@@ -187,14 +188,18 @@ void FlowEngine::adopt_finished_remesh() {
 
 void FlowEngine::remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii,
                                       const BoxWalls& walls, double dt) {
-  // Snapshot now, build on another thread, carry on with the current mesh meanwhile.
-  pending_ = Pending{std::async(std::launch::async,
-                                [c = centres, r = radii, w = walls, s = settings, b = bc, dt, o = linear_.ordering]() {
-                                  PoreMesh m = build_pore_mesh(c, r, w, s);
-                                  CellConditions flat = flat_cells(m, s);
-                                  LinearSystem l = build_linear_system(m, b, s, dt, o.get(), nullptr, {&flat});
-                                  return Remesh{std::move(m), std::move(l), std::move(flat)};
-                                })};
+  // Snapshot now, build on another thread, carry on with the current mesh meanwhile. The current
+  // solver stays in use; an empty multigrid solver stands for it where kAuto keeps that choice
+  // (without it the worker would pay the ordering and analysis that decided it again).
+  pending_ = Pending{std::async(std::launch::async, [c = centres, r = radii, w = walls, s = settings, b = bc, dt,
+                                                     o = linear_.ordering, keep = auto_keeps_multigrid()]() {
+    PoreMesh m = build_pore_mesh(c, r, w, s);
+    CellConditions flat = flat_cells(m, s);
+    std::unique_ptr<PressureSolver> recycled;
+    if (keep) recycled = std::make_unique<AmgSolver>();
+    LinearSystem l = build_linear_system(m, b, s, dt, o.get(), std::move(recycled), {&flat});
+    return Remesh{std::move(m), std::move(l), std::move(flat)};
+  })};
   strain_ = 0;
   steps_since_remesh_ = 0;
 }
@@ -272,14 +277,19 @@ bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditio
   return carried;
 }
 
+bool FlowEngine::auto_keeps_multigrid() const {
+  return settings.solver == SolverKind::kAuto && linear_.solver && linear_.solver->kind() == SolverKind::kMultigrid &&
+         linear_.recipe.max_factor_bytes == settings.max_factor_bytes;
+}
+
 std::unique_ptr<PressureSolver> FlowEngine::released_solver() {
-  auto solver = std::move(linear_.solver);
-  if (solver) solver->release();
   // Under kAuto a multigrid solver carried over keeps the choice (build_linear_system); a new
   // max_factor_bytes asks for it again.
-  if (solver && settings.solver == SolverKind::kAuto && solver->kind() == SolverKind::kMultigrid &&
-      linear_.recipe.max_factor_bytes != settings.max_factor_bytes)
-    solver.reset();
+  const bool drop = settings.solver == SolverKind::kAuto && linear_.solver &&
+                    linear_.solver->kind() == SolverKind::kMultigrid && !auto_keeps_multigrid();
+  auto solver = std::move(linear_.solver);
+  if (solver) solver->release();
+  if (drop) solver.reset();
   return solver;
 }
 

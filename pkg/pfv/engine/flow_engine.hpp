@@ -239,6 +239,9 @@ class FlowEngine {
   // The current system's solver with its factor freed, handed over to the next build (the
   // storage of the factor's values is reused): peak memory one factor, no new pages to fault.
   std::unique_ptr<PressureSolver> released_solver();
+  // Under kAuto: multigrid was chosen for the current system and the bound it was chosen against
+  // is unchanged, so the next system keeps it without an analysis (build_linear_system).
+  bool auto_keeps_multigrid() const;
 
   std::unique_ptr<PoreMesh> mesh_;
   LinearSystem linear_;

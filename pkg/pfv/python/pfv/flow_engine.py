@@ -121,6 +121,7 @@ _INTERNAL = frozenset({
     "_boundary_use_max_min",  # boundaryUseMaxMin
     "_wall_ids",              # wallIds
     "_warned",                # the one-time warnings given
+    "_choice_builds",         # core.system_builds when the solver choice was last looked at
     "_threads",               # ompThreads, None: follow YADE's -j
     "_use_sphere_pack",       # False: always read the coordinate lists
 }) | CELL_INTERNAL | FIELD_INTERNAL
@@ -149,6 +150,7 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
         self._boundary_use_max_min = [True] * 6
         self._wall_ids = list(range(6))
         self._warned = set()
+        self._choice_builds = 0
         self._scan = None
         self._use_sphere_pack = True
         self._threads = None
@@ -401,9 +403,11 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
                           "remesh that pore cells were turned inside out; remeshed (and will again whenever "
                           "this happens). Lower meshUpdateInterval or defTolerance for motion this fast",
                           stacklevel=2)
-        if "auto multigrid" not in self._warned and core.solver == "auto":
+        # The choice changes only with a new system: look at it once per build, not per step.
+        if "auto multigrid" not in self._warned and core.system_builds != self._choice_builds:
+            self._choice_builds = core.system_builds
             choice = core.solver_choice
-            if choice.startswith("multigrid: the Cholesky"):  # not "kept from the previous mesh"
+            if core.solver == "auto" and choice.startswith("multigrid: the Cholesky"):  # not "kept from ..."
                 self._warned.add("auto multigrid")
                 bound = ", or raise max_factor_bytes" if "budget" in choice else ""  # not CHOLMOD's index range
                 warnings.warn(f"pfv.FlowEngine: solver='auto' solves by multigrid from iteration {scene.iter}: "

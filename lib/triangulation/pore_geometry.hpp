@@ -64,9 +64,14 @@ CellShape make_cell_shape(const Mesh& mesh, int cell);
 // Total volume of a cell for the current positions, signed by the orientation of its vertices
 // (the sign of the triple product; for wall cells, of the sphere part projected on the wall).
 double oriented_cell_volume(const CellShape& s, const std::vector<Vec3>& centre, const BoxWalls& walls);
-// |oriented_cell_volume|: what dV/dt differentiates.
+// oriented_cell_volume in the orientation the cell had when the mesh was built: what dV/dt
+// differentiates. It turns negative when motion turns the cell inside out, and that sign is what
+// keeps the mesh conservative until the next remesh: the signed volumes of the cells still sum to
+// the volume they tile, so the volume rates sum to the rate of change of that volume (the motion
+// of the walls) however the spheres move. Cells flat when built have no orientation: |volume|.
 inline double cell_volume(const CellShape& s, const std::vector<Vec3>& centre, const BoxWalls& walls) {
-  return std::abs(oriented_cell_volume(s, centre, walls));
+  const double oriented = oriented_cell_volume(s, centre, walls);
+  return s.orientation != 0 ? s.orientation * oriented : std::abs(oriented);
 }
 
 CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& packing);

@@ -19,6 +19,16 @@ namespace pfv {
 namespace {
 
 constexpr double kInversionFraction = 1e-3;  // of the mean cell volume (assemble)
+// The part of the meshed volume that may be inside out before a step remeshes out of schedule
+// (assemble). Below it the step runs on, as YADE's engine does until its scheduled remesh: the
+// signed volumes keep the mass balance exact (cell_volume), and the error is that of the
+// conductances and force areas of the old mesh, which grows with the motion since the remesh
+// whether cells flip or not, and which the user's remesh schedule bounds. A fraction of the volume
+// is a property of the motion, not of the packing's size: a cell flipping somewhere in a million
+// costs no remesh. Random motion of every sphere by a fifth of the spacing since the remesh turns
+// about 1 % of the volume inside out (mostly slivers) and puts the forces of the old mesh about a
+// quarter off those of a fresh one (doc/model.md); twice that motion is past any useful schedule.
+constexpr double kInvertedVolumeForRemesh = 0.02;
 
 }  // namespace
 
@@ -128,10 +138,10 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
   // From here on everything writes into scratch buffers; the engine's state changes only in
   // commit(), once the step has produced finite pressures and forces.
   double strain = assemble(centres, walls, dt);
-  if (inverted_cells_ > 0) {
-    // Spheres moved so far since the remesh that cells turned inside out: their volumes and
-    // throats mean nothing any more (fluxes of the wrong sign). Remesh at these positions,
-    // whatever the schedule says.
+  if (inverted_volume_ > kInvertedVolumeForRemesh * meshed_volume_) {
+    // Spheres moved so far since the remesh that 2 % of the volume turned inside out: the
+    // throats no longer describe the pore space. Remesh at these positions, whatever the
+    // schedule says. (Less runs on with signed volumes: see cell_volume.)
     remesh_now(centres, radii, walls, dt);
     ++inversion_remeshes_;
     strain = assemble(centres, walls, dt);
@@ -359,23 +369,29 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   double max_change = 0;
   // A cell counts as turned inside out once its flipped volume exceeds a small part of the mean:
   // the slivers of a dense packing (volumes far below the mean) flip under any small motion,
-  // harmlessly, and must not force remeshes.
+  // harmlessly, and must not count.
   const double inside_out = -kInversionFraction * mesh_->mean_cell_volume;
   int inverted_cells = 0;
+  double inverted_volume = 0, meshed_volume = 0;
   next_volume_.resize(nc);
   volume_rate_.resize(nc);
-#pragma omp parallel for schedule(static) reduction(max : max_change) reduction(+ : inverted_cells) if (nc > kMinParallelLoop)
+#pragma omp parallel for schedule(static) reduction(max : max_change) \
+    reduction(+ : inverted_cells, inverted_volume, meshed_volume) if (nc > kMinParallelLoop)
   for (int c = 0; c < nc; ++c) {
     const CellShape& shape = mesh_->cells.shape[c];
-    const double oriented = oriented_cell_volume(shape, centres, walls);
-    inverted_cells += shape.orientation * oriented < inside_out;
-    const double v = std::abs(oriented);
+    const double v = cell_volume(shape, centres, walls);
+    const bool inverted = v < inside_out;
+    inverted_cells += inverted;
+    inverted_volume += inverted ? -v : 0.0;
+    meshed_volume += std::abs(v);
     const double dv = has_prev_ ? v - volume_[c] : 0.0;
     volume_rate_[c] = dv / dt;
     max_change = std::max(max_change, std::abs(dv) / std::max(v, mesh_->mean_cell_volume));
     next_volume_[c] = v;
   }
   inverted_cells_ = inverted_cells;
+  inverted_volume_ = inverted_volume;
+  meshed_volume_ = meshed_volume;
   if (settings.volume_correction != 1)
     for (int c = 0; c < nc; ++c)
       if (mesh_->cells.shape[c].n_walls == 0) volume_rate_[c] *= settings.volume_correction;

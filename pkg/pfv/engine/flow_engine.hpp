@@ -171,9 +171,14 @@ class FlowEngine {
   // Which solver the current system uses and why (LinearSystem::choice); empty before.
   const std::string& solver_choice() const { return linear_.choice; }
   int remesh_count() const { return remesh_count_; }
-  // Remeshes forced because the spheres had turned cells inside out since the last remesh
-  // (motion too large for the remesh schedule); each also counts in remesh_count().
+  // Remeshes forced because the spheres had turned 2 % of the meshed volume inside out since
+  // the last remesh (motion too large for the remesh schedule); each also counts in remesh_count().
   int inversion_remeshes() const { return inversion_remeshes_; }
+  // Cells inside out at the last step's positions (a flipped volume above a small part of the
+  // mean), and the part of the meshed volume they hold. Up to 2 % of the volume the step runs
+  // on with signed volumes until the scheduled remesh; beyond, it remeshes at once.
+  int inverted_cells() const { return inverted_cells_; }
+  double inverted_volume_fraction() const { return meshed_volume_ > 0 ? inverted_volume_ / meshed_volume_ : 0.0; }
   // Linear systems adopted so far: one per remesh, plus one per rebuild without a remesh.
   int system_builds() const { return system_builds_; }
   // Steps that evaluated the pressure_field so far.
@@ -263,6 +268,7 @@ class FlowEngine {
   int steps_since_remesh_ = 0;
   int remesh_count_ = 0;
   int inverted_cells_ = 0;  // of the last assemble()
+  double inverted_volume_ = 0, meshed_volume_ = 0;  // likewise: |volume| of those cells, and of all
   int inversion_remeshes_ = 0;
   int system_builds_ = 0;
   int field_evaluations_ = 0;

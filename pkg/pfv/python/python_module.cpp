@@ -497,7 +497,13 @@ PYBIND11_MODULE(_core, m) {
            exclusive([](const SharedEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; }))
       .def_property_readonly("remesh_count", exclusive(&FlowEngine::remesh_count))
       .def_property_readonly("inversion_remeshes", exclusive(&FlowEngine::inversion_remeshes),
-                             "Remeshes forced by cells turned inside out (motion too large for the schedule).")
+                             "Remeshes forced by 2 % of the meshed volume turned inside out (motion too large\n"
+                             "for the schedule).")
+      .def_property_readonly("inverted_cells", exclusive(&FlowEngine::inverted_cells),
+                             "Cells inside out at the last step's positions; up to 2 % of the volume inside out\n"
+                             "the step runs on with signed volumes (mass conserved) until the scheduled remesh.")
+      .def_property_readonly("inverted_volume_fraction", exclusive(&FlowEngine::inverted_volume_fraction),
+                             "The part of the meshed volume inverted_cells hold.")
       .def_property_readonly("mesh_viscosity", exclusive(&FlowEngine::mesh_viscosity),
                              "The viscosity of the current mesh's conductances.")
       .def_property_readonly("system_builds", exclusive(&FlowEngine::system_builds))

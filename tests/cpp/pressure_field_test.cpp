@@ -38,7 +38,7 @@ TEST(PressureField, RightHandSideOnlyOncePerStepAndLinear) {
   const std::vector<double> first = e.pressure();
   int wall_cells = 0;
   for (std::size_t c = 0; c < first.size(); ++c)
-    if (e.system().source[c] == 3) {
+    if (e.system().source[c].is_wall(3)) {
       ++wall_cells;
       EXPECT_DOUBLE_EQ(first[c], 1 + std::cos(M_PI * e.cells().power_centre[c].x()));
     }

@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "pfv/engine/flow_engine.hpp"
+#include "pfv/engine/viscous_stability.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;
@@ -27,7 +28,7 @@ Reference dense_reference(const FlowEngine& e, const std::vector<double>& mass) 
   for (int k = 0; k < n; ++k)
     for (int d = 0; d < 3; ++d) {
       v[k][d] = 1;
-      e.apply_viscous_operator(mass, v, a);
+      apply_viscous_operator(e, mass, v, a);
       v[k][d] = 0;
       for (int i = 0; i < n; ++i) A.block<3, 1>(3 * i, 3 * k + d) = a[i];
     }
@@ -59,27 +60,27 @@ TEST(ViscousStability, ArnoldiAndPowerIterationMatchTheDenseSpectrum) {
   ASSERT_GT(ref.lambda_max, 0);
 
   std::vector<Vec3> mode;
-  const double cold = e.viscous_stability_limit(mass, 40, &mode);
+  const double cold = viscous_stability_limit(e, mass, 40, &mode);
   EXPECT_NEAR(cold, 2 / ref.lambda_max, 1e-5 * cold);
   EXPECT_GT(alignment(mode, ref.mode), 0.999);
   EXPECT_EQ(mode[3], Vec3::Zero());
 
   // Started from that mode, the power iteration stays on it (warm start of a remesh).
-  const double warm = e.viscous_stability_limit(mass, 10, &mode);
+  const double warm = viscous_stability_limit(e, mass, 10, &mode);
   EXPECT_NEAR(warm, 2 / ref.lambda_max, 5e-3 * warm);
   EXPECT_GT(alignment(mode, ref.mode), 0.99);
 
   int applications = 0;
-  e.viscous_stability_limit(mass, 40, nullptr, &applications);
+  viscous_stability_limit(e, mass, 40, nullptr, &applications);
   EXPECT_GT(applications, 5);
   EXPECT_LE(applications, 40);
   std::vector<double> bad = mass;
   bad[7] = std::nan("");
-  EXPECT_THROW(e.viscous_stability_limit(bad, 40), std::invalid_argument);
+  EXPECT_THROW(viscous_stability_limit(e, bad, 40), std::invalid_argument);
 
   // Fewer operator applications than the spectrum needs: an estimate from inside the
   // spectrum, i.e. a limit above the true one (why the engine keeps a safety factor).
-  EXPECT_GE(e.viscous_stability_limit(mass, 3), 2 / ref.lambda_max * (1 - 1e-9));
+  EXPECT_GE(viscous_stability_limit(e, mass, 3), 2 / ref.lambda_max * (1 - 1e-9));
 }
 
 // dV/dt enters the operator by a difference of the cell volumes: a step too large leaves their
@@ -100,10 +101,10 @@ TEST(ViscousStability, TheOperatorIsLinearInTheVelocities) {
     twice[k] = 2 * v[k];
   }
   std::vector<Vec3> av, aw, asum, atwice;
-  e.apply_viscous_operator(mass, v, av);
-  e.apply_viscous_operator(mass, w, aw);
-  e.apply_viscous_operator(mass, sum, asum);
-  e.apply_viscous_operator(mass, twice, atwice);
+  apply_viscous_operator(e, mass, v, av);
+  apply_viscous_operator(e, mass, w, aw);
+  apply_viscous_operator(e, mass, sum, asum);
+  apply_viscous_operator(e, mass, twice, atwice);
   double scale = 0, additivity = 0, homogeneity = 0;
   for (int k = 0; k < n; ++k) {
     scale = std::max(scale, asum[k].norm());
@@ -162,7 +163,7 @@ TEST(ViscousStability, TheBoundsAreBelowTheLimitOfTheDenseSpectrum) {
     for (std::size_t k = 0; k < mass.size(); ++k) mass[k] = 2600 * 4.0 / 3 * M_PI * std::pow(p.radius[k], 3);
     mass[3] = 0;
     const double limit = 2 / dense_reference(e, mass).lambda_max;
-    const double global = e.viscous_stability_bound(mass), local = e.viscous_stability_local_bound(mass);
+    const double global = viscous_stability_bound(e, mass), local = viscous_stability_local_bound(e, mass);
     std::printf("  %s: global bound / limit = %.3g, local bound / limit = %.3g\n", variant.name, global / limit,
                 local / limit);
     EXPECT_GT(global, 0);
@@ -186,16 +187,16 @@ TEST(ViscousStability, NoBoundWithTheShearTermOrWithoutAMesh) {
   const auto p = test::random_packing(60, 3, 0.06, 0.09);
   std::vector<double> mass(p.radius.size(), 1.0);
   FlowEngine e = test::permeameter(1);
-  EXPECT_THROW(e.viscous_stability_bound(mass), std::logic_error);
-  EXPECT_THROW(e.viscous_stability_local_bound(mass), std::logic_error);
+  EXPECT_THROW(viscous_stability_bound(e, mass), std::logic_error);
+  EXPECT_THROW(viscous_stability_local_bound(e, mass), std::logic_error);
   e.settings.viscous_shear = true;
   e.step(p.centre, p.radius, p.walls, 1e-4);
-  EXPECT_EQ(e.viscous_stability_bound(mass), 0);
-  EXPECT_EQ(e.viscous_stability_local_bound(mass), 0);
+  EXPECT_EQ(viscous_stability_bound(e, mass), 0);
+  EXPECT_EQ(viscous_stability_local_bound(e, mass), 0);
   std::vector<double> bad = mass;
   bad[2] = std::nan("");
-  EXPECT_THROW(e.viscous_stability_bound(bad), std::invalid_argument);
-  EXPECT_THROW(e.viscous_stability_local_bound(bad), std::invalid_argument);
-  EXPECT_THROW(e.viscous_stability_bound(std::vector<double>(5, 1.0)), std::invalid_argument);
-  EXPECT_THROW(e.viscous_stability_local_bound(std::vector<double>(5, 1.0)), std::invalid_argument);
+  EXPECT_THROW(viscous_stability_bound(e, bad), std::invalid_argument);
+  EXPECT_THROW(viscous_stability_local_bound(e, bad), std::invalid_argument);
+  EXPECT_THROW(viscous_stability_bound(e, std::vector<double>(5, 1.0)), std::invalid_argument);
+  EXPECT_THROW(viscous_stability_local_bound(e, std::vector<double>(5, 1.0)), std::invalid_argument);
 }

@@ -1,15 +1,17 @@
 // The coupled flow engine: one call per DEM step runs the pipeline
 //   scene snapshot -> (remesh: pore mesh, linear system) -> dV/dt -> solve -> forces.
-// It knows nothing of YADE; pkg/pfv/python adapts it to YADE's FlowEngine interface.
+// It knows nothing of YADE; pkg/pfv/python adapts it to YADE's FlowEngine interface. What is
+// computed from a finished step lives beside it: flow_queries.hpp (fluxes, averages),
+// viscous_stability.hpp (the stability limit); the right-hand-side physics is model/'s
+// (pressure_rhs.hpp), the remesh schedule and background remesh remesher.hpp's.
 #pragma once
-#include <future>
 #include <memory>
-#include <optional>
 #include <vector>
 
 #include "pfv/engine/engine_settings.hpp"
 #include "pfv/engine/linear_system.hpp"
 #include "pfv/engine/pore_mesh.hpp"
+#include "pfv/engine/remesher.hpp"
 #include "pfv/engine/stage_times.hpp"
 #include "pfv/model/boundary_conditions.hpp"
 #include "pfv/model/cell_conditions.hpp"
@@ -27,7 +29,6 @@ class FlowEngine {
   FlowEngine() = default;
   FlowEngine(FlowEngine&&) = default;
   FlowEngine& operator=(FlowEngine&&) = default;
-  ~FlowEngine();
 
   // One coupled step at positions X(t); dt is the DEM step that led here.
   // Throws std::invalid_argument on bad positions or settings, std::domain_error on a singular
@@ -39,7 +40,7 @@ class FlowEngine {
   // runs in between). Throws as step() does for bad positions or settings.
   void remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls);
   // The next step remeshes (in the foreground).
-  void request_remesh() { remesh_requested_ = true; }
+  void request_remesh() { remesher_.request(); }
   // The next step rebuilds the linear system (YADE's updateBCs; changes of the boundary types,
   // imposed points and solver settings are noticed without it).
   void request_system_rebuild() { system_rebuild_requested_ = true; }
@@ -69,44 +70,10 @@ class FlowEngine {
   // Throws std::invalid_argument (as a step would) for a state whose positions are invalid, or
   // whose pressures do not match the rebuilt mesh; the engine is then left without a mesh.
   void resume(const RunState& state, double dt);
-  bool remesh_due() const;
-  bool remesh_pending() const { return pending_.has_value(); }
-  // Blocks until a background remesh in flight has finished; the next step adopts it.
-  void wait_for_remesh() const {
-    if (pending_) pending_->result.wait();
-  }
+  bool remesh_due() const { return remesher_.due(settings, mesh_.get()); }
+  // The remesh schedule (steps and strain since the last remesh) and a background remesh in flight.
+  const Remesher& remesher() const { return remesher_; }
   bool has_mesh() const { return mesh_ != nullptr; }
-  // The viscosity of the current mesh's conductances: settings.conductance.viscosity once a step
-  // has run since it changed.
-  double mesh_viscosity() const { return mesh_ ? mesh_->viscosity() : settings.conductance.viscosity; }
-
-  // Stability limit of the explicit coupling from the fluid alone: 2 / lambda_max of
-  // M^-1 V, where V maps sphere velocities to fluid forces through the current mesh
-  // (dV/dt -> solve -> forces, plus the viscous shear term when on), linearised about the
-  // last step's positions; masses <= 0 mark spheres that do not move. Collective modes
-  // (groups of spheres squeezing shared pores) make this smaller than the thesis'
-  // single-particle dt_MV. Needs a mesh (viscous_stability.cpp).
-  // Without a mode: Arnoldi from a fixed start, at most 'iterations' operator applications,
-  // stopping once the largest Ritz value changes by less than 1e-6 or its residual is below
-  // 1e-3 of it (at least 8 applications). mode: if given with one
-  // entry per sphere (not all zero), power iteration starts from it instead (warm start from
-  // the previous mesh's mode, stopping once the estimate changes by less than 0.5 %). On
-  // return mode holds the estimated eigenvector (unit norm), and applications (if given) the
-  // number of operator applications made. Throws std::domain_error if the operator gives a
-  // non-finite estimate.
-  double viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode = nullptr,
-                                 int* applications = nullptr) const;
-  // Certified lower bounds on viscous_stability_limit (viscous_stability_bounds.cpp), 0 where
-  // there is none (viscous shear on, or the pressure matrix not of the form the argument needs).
-  // The global bound costs about one solve and lies up to four orders of magnitude below the
-  // limit, the further the longer the drainage path; the local bound solves only small problems
-  // around each sphere, costs more at these sizes, and lies within an order of magnitude.
-  double viscous_stability_bound(const std::vector<double>& mass) const;
-  double viscous_stability_local_bound(const std::vector<double>& mass) const;
-  // accel = M^-1 F(v): the fluid forces of the sphere velocities v on the current mesh over
-  // the masses (zero for mass <= 0). The operator of viscous_stability_limit; public for tests.
-  void apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,
-                              std::vector<Vec3>& accel) const;
 
   // Conditions on single cells of the current mesh (YADE's setCellPImposed, setCellPressure,
   // blockCell; cell_conditions.hpp). A remesh clears them, as it renumbers the cells. A change
@@ -114,9 +81,6 @@ class FlowEngine {
   // imposed: the cell's pressure is imposed at the value it holds (else it is an unknown even
   // where a boundary would impose it).
   void set_cell_imposed(int cell, bool imposed);
-  // Whether the cell's pressure is imposed: by its own condition, else by a pressure wall or an
-  // imposed point of the current boundary conditions (a blocked cell: blocked with its pressure).
-  bool cell_imposed(int cell) const;
   // The pressure the cell holds: the value an imposed cell keeps, the state a compressible
   // cell starts the next step from; an unknown of an incompressible fluid is solved anew.
   // Throws std::invalid_argument if p is not finite.
@@ -145,31 +109,25 @@ class FlowEngine {
   const ViscousShear* viscous_shear() const { return mesh_ && mesh_->shear ? &*mesh_->shear : nullptr; }
   const std::vector<double>& pressure() const { return pressure_; }
   const std::vector<double>& volume_rates() const { return volume_rate_; }  // dV/dt per cell
-  // The positions of the last step (of the last update_volumes, if later).
-  const std::vector<Vec3>& last_centres() const { return centres_prev_; }
+  // The current mesh, with its geometry, conductances and force cache (needs a mesh).
+  const PoreMesh& pore_mesh() const { return *mesh_; }
   const Mesh& mesh() const { return mesh_->mesh(); }
   const CellGeometry& cells() const { return mesh_->cells; }
   const FacetGeometry& facets() const { return mesh_->facets; }
   const std::vector<double>& conductances() const { return mesh_->k; }
   const PressureSystem& system() const { return linear_.system; }
+  // The current linear system with its solver and the cells of the boundary conditions.
+  const LinearSystem& linear_system() const { return linear_; }
   const BoxWalls& walls() const { return walls_prev_; }
-  // The sphere centres of the last step (empty before the first): the positions of walls() and pressure().
+  // The sphere centres of the last step (of the last update_volumes, if later; empty before the first): the
+  // positions of walls() and pressure().
   const std::vector<Vec3>& positions() const { return centres_prev_; }
-  double boundary_flux(int wall) const;
-  double imposed_flux_total() const;
-  double volume_rate_total() const;  // sum of dV/dt over all cells
-  double average_pressure() const;
-  double average_slice_pressure(int axis, double position) const;
-  int locate(const Vec3& x) const { return mesh_ ? mesh_->tri.locate(x) : -1; }
-  bool metis_used() const;
   // The Cholesky factor of the current system; throws std::logic_error with another solver.
   const CholmodSolver& cholmod() const;
   // The current system's Cholesky solver, or nullptr (another solver, or no system yet).
   const CholeskySolver* cholesky() const { return linear_.cholesky(); }
   // The current system's solver, null before the first step.
   const PressureSolver* pressure_solver() const { return linear_.solver.get(); }
-  // Which solver the current system uses and why (LinearSystem::choice); empty before.
-  const std::string& solver_choice() const { return linear_.choice; }
   int remesh_count() const { return remesh_count_; }
   // Remeshes forced because the spheres had turned 2 % of the meshed volume inside out since
   // the last remesh (motion too large for the remesh schedule); each also counts in remesh_count().
@@ -183,31 +141,14 @@ class FlowEngine {
   int system_builds() const { return system_builds_; }
   // Steps that evaluated the pressure_field so far.
   int field_evaluations() const { return field_evaluations_; }
-  double accumulated_strain() const { return strain_; }
   const SolveStats& last_solve() const { return last_solve_; }
   // The right-hand side and the solution of the last solve, one value per unknown of system().
   const std::vector<double>& last_rhs() const { return rhs_; }
   const std::vector<double>& last_solution() const { return solution_; }
-  double refinement_contraction() const;  // -1 until measured, or without a 32-bit factor
   const StageTimes& remesh_times() const { return remesh_times_; }
   const StageTimes& step_times() const { return step_times_; }
-  const StageTimes& system_times() const { return linear_.times; }  // assembly, analysis, factorization
 
  private:
-  struct Remesh {
-    PoreMesh mesh;
-    LinearSystem linear;
-    CellConditions cells;  // those of a new mesh: its flat cells
-  };
-  struct Pending {
-    std::future<Remesh> result;
-  };
-
-  // Throws unless there is a mesh and one finite mass per sphere of it (the stability limits).
-  void check_stability_inputs(const std::vector<double>& mass) const;
-  // The displacement by which the stability limit and its bounds difference cell volumes: a tiny
-  // fraction of the box, the same for all of them so that they differentiate alike.
-  double volume_probe_step() const;
   // The stages of step(), in order.
   void validate_step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                      double dt) const;
@@ -215,28 +156,23 @@ class FlowEngine {
                        double dt);
   void rebuild_stale_system(double dt);
   double assemble(const std::vector<Vec3>& centres, const BoxWalls& walls, double dt);  // returns the pore strain
-  void assemble_rhs();  // once per step, on the mesh the step solves on
-  void apply_pressure_field();
+  void assemble_rhs();  // once per step, on the mesh the step solves on (pressure_rhs.hpp)
   void solve();
   void compute_forces(const std::vector<Vec3>& centres, const std::vector<double>& radii, double dt);
   void commit(const std::vector<Vec3>& centres, const BoxWalls& walls, double strain);
 
-  void adopt_finished_remesh();
   // The volume of every cell at these positions; throws std::invalid_argument if they do not
   // belong to the mesh's spheres.
   std::vector<double> volumes_at(const std::vector<Vec3>& centres, const BoxWalls& walls) const;
-  void remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
-                            double dt);
+
+  // Adopting a new mesh (flow_engine_remesh.cpp).
+  void adopt_finished_remesh();
   void remesh_now(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
   // The first half of a foreground remesh: a background remesh in flight is superseded, the mesh
   // of these positions is built, with its flat cells and the blocked cells carried over.
   Remesh mesh_without_system(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls);
-  // The last half: the remesh schedule starts again.
-  void restart_schedule();
   // with_system: the linear system of the mesh (else an empty one, built at the next step).
   void adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system = true);
-  // The conditions of a new mesh: its cells of at most settings.flat_threshold volume blocked.
-  static CellConditions flat_cells(const PoreMesh& mesh, const EngineSettings& settings);
   // With settings.interpolates(solver in use), blocks the cells of the new mesh whose barycentres (at these
   // positions) lie in a blocked cell of the current one; returns whether it blocked any.
   bool carry_blocked_cells(const PoreMesh& mesh, CellConditions& conditions, const std::vector<Vec3>& centres,
@@ -250,12 +186,12 @@ class FlowEngine {
 
   std::unique_ptr<PoreMesh> mesh_;
   LinearSystem linear_;
-  std::optional<Pending> pending_;
+  Remesher remesher_;
 
   std::vector<double> pressure_, volume_, volume_rate_, rhs_, solution_;
   std::vector<Vec3> force_;
   std::vector<double> next_volume_, next_pressure_;  // scratch of the step being computed
-  std::vector<double> field_values_;                 // scratch of apply_pressure_field
+  std::vector<double> field_values_;                 // scratch of the pressure field
   std::vector<double> pressure_before_;              // the step before pressure_'s, on this mesh (extrapolated start)
   bool keep_trend_ = false;                          // the solver of this step wants the extrapolated start next
   bool pressures_solved_ = false;                    // pressure_ solved on this mesh (or carried over), not pZero
@@ -264,8 +200,6 @@ class FlowEngine {
   std::vector<Vec3> centres_prev_;
   BoxWalls walls_prev_;
   bool has_prev_ = false;
-  double strain_ = 0;
-  int steps_since_remesh_ = 0;
   int remesh_count_ = 0;
   int inverted_cells_ = 0;  // of the last assemble()
   double inverted_volume_ = 0, meshed_volume_ = 0;  // likewise: |volume| of those cells, and of all
@@ -275,7 +209,6 @@ class FlowEngine {
   SolveStats last_solve_;
   CellConditions cells_;                      // of the current mesh
   std::vector<double> measured_void_volume_;  // of the current mesh, by initialize_volumes (else empty)
-  bool remesh_requested_ = true;
   bool system_rebuild_requested_ = false;
   StageTimes remesh_times_, step_times_;
 };

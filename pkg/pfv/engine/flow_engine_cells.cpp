@@ -15,24 +15,6 @@ void FlowEngine::set_cell_imposed(int cell, bool imposed) {
     system_rebuild_requested_ = true;
 }
 
-bool FlowEngine::cell_imposed(int cell) const {
-  switch (cells_.pressure_of(cell)) {
-    case CellPressure::kImposed:
-      return true;
-    case CellPressure::kFree:
-      return false;
-    case CellPressure::kFollowBoundaries:
-      break;
-  }
-  if (cells_.is_blocked(cell)) return false;
-  const Mesh& m = mesh();
-  for (int v : m.cell_vertices[cell])
-    if (m.is_wall(v) && bc.is_pressure[m.wall_of(v)]) return true;
-  for (const PointCondition& point : bc.imposed_pressure)  // as the next system will place them
-    if (locate(point.position) == cell) return true;
-  return false;
-}
-
 void FlowEngine::set_cell_pressure(int cell, double p) {
   if (!std::isfinite(p))
     throw std::invalid_argument("the pressure of cell " + std::to_string(cell) + " must be finite");

@@ -204,21 +204,13 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   const PressureSystem& s = l.system;
   if (!bc.profile.empty())
     for (int c = 0; c < m.mesh().n_cells(); ++c)
-      if (s.source[c] == bc.profile.wall) {
+      if (s.source[c].is_wall(bc.profile.wall)) {
         // Beyond the profile's points the wall's value applies, read at every step as usual.
         const double x = m.cells.power_centre[c][bc.profile.axis];
         const double p = profile_pressure(bc.profile, x, std::numeric_limits<double>::quiet_NaN());
         if (!std::isnan(p)) l.profile_pressure.emplace_back(c, p);
       }
-  for (int u = 0; u < s.n_unknowns(); ++u) {
-    const int c = s.unknown_cell[u];
-    for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e)
-      if (s.unknown[s.adj_cell[e]] < 0 && s.adj_k[e] != 0) {  // no coupling through a blocked cell
-        l.coupling_unknown.push_back(u);
-        l.coupling_cell.push_back(s.adj_cell[e]);
-        l.coupling_k.push_back(s.adj_k[e]);
-      }
-  }
+  l.couplings = dirichlet_couplings(s);
   l.times.assembly = seconds_since(t0);
 
   t0 = StageClock::now();

@@ -16,6 +16,7 @@
 #include "pfv/linalg/pressure_solver.hpp"
 #include "pfv/model/boundary_conditions.hpp"
 #include "pfv/model/cell_conditions.hpp"
+#include "pfv/model/pressure_rhs.hpp"
 #include "pfv/model/pressure_system.hpp"
 
 namespace pfv {
@@ -49,19 +50,14 @@ struct SystemRecipe {
 
 struct LinearSystem {
   PressureSystem system;
-  std::vector<int> coupling_unknown, coupling_cell;  // Dirichlet neighbours of unknowns
-  std::vector<double> coupling_k;
+  DirichletCouplings couplings;
   std::unique_ptr<PressureSolver> solver;        // null until built
   std::shared_ptr<const CellOrdering> ordering;  // of a Cholesky factor, for the next remesh
   std::vector<int> imposed_pressure_cells, imposed_flux_cells;
   std::vector<double> storage;  // V_f / (K dt) per cell; empty for an incompressible fluid
   // (cell, pressure) of the Dirichlet cells of bc.profile's wall; empty without a profile.
   std::vector<std::pair<int, double>> profile_pressure;
-  // The Dirichlet cells of the PressureField's wall and their power centres, gathered at the
-  // first step that needs them (field_wall: their wall, -1 before).
-  int field_wall = -1;
-  std::vector<int> field_cells;
-  std::vector<Vec3> field_at;
+  FieldCells field;  // of the PressureField's wall, gathered at the first step that needs them
   SystemRecipe recipe;
   // The solver built and why ("multigrid: the Cholesky factor would store ..."), for reports.
   std::string choice;

@@ -1,5 +1,5 @@
 // The viscous stability limit of the explicit coupling, 2 / lambda_max of M^-1 V, where V maps
-// sphere velocities to fluid forces through the current mesh (flow_engine.hpp).
+// sphere velocities to fluid forces through the current mesh (viscous_stability.hpp).
 //
 // A first mesh has no good starting vector, and power iteration from an arbitrary one creeps:
 // the dense packings measured need 40 iterations, each a solve and a force evaluation. The Krylov space of those same
@@ -15,8 +15,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "pfv/engine/flow_engine.hpp"
 #include "pfv/engine/pore_mesh.hpp"
+#include "pfv/engine/viscous_stability.hpp"
 
 namespace pfv {
 namespace {
@@ -43,12 +43,12 @@ constexpr int kMinKrylov = 8;
 
 }  // namespace
 
-void FlowEngine::check_stability_inputs(const std::vector<double>& mass) const {
+void check_stability_inputs(const FlowEngine& e, const std::vector<double>& mass) {
   // Linearised about the positions of the last step, which the mesh holds once a step on it has
   // succeeded (a forgotten history, reset_history(), does not matter here).
-  if (!has_mesh() || centres_prev_.size() != static_cast<std::size_t>(mesh().n_spheres))
+  if (!e.has_mesh() || e.positions().size() != static_cast<std::size_t>(e.mesh().n_spheres))
     throw std::logic_error("the stability limit needs a mesh: run a step first");
-  const int n = mesh().n_spheres;
+  const int n = e.mesh().n_spheres;
   if (static_cast<int>(mass.size()) != n)
     throw std::invalid_argument("one mass per sphere of the mesh is needed (" + std::to_string(n) + " spheres, " +
                                 std::to_string(mass.size()) + " masses)");
@@ -56,46 +56,46 @@ void FlowEngine::check_stability_inputs(const std::vector<double>& mass) const {
     if (!std::isfinite(mass[k])) throw std::invalid_argument("mass of sphere " + std::to_string(k) + " is not finite");
 }
 
-double FlowEngine::volume_probe_step() const {
+double volume_probe_step(const FlowEngine& e) {
   double h = 0;
-  for (int a = 0; a < 3; ++a) h = std::max(h, walls_prev_.extent(a));
+  for (int a = 0; a < 3; ++a) h = std::max(h, e.walls().extent(a));
   return 1e-7 * h;
 }
 
-void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const std::vector<Vec3>& v,
-                                        std::vector<Vec3>& accel) const {
-  const int n = mesh().n_spheres, nc = mesh().n_cells();
-  const PressureSystem& system = linear_.system;
+void apply_viscous_operator(const FlowEngine& e, const std::vector<double>& mass, const std::vector<Vec3>& v,
+                            std::vector<Vec3>& accel) {
+  const int n = e.mesh().n_spheres, nc = e.mesh().n_cells();
+  const PressureSystem& system = e.linear_system().system;
   const int nu = system.n_unknowns();
-  const double h = volume_probe_step();
-  std::vector<Vec3> shifted(centres_prev_), force, shear;
+  const double h = volume_probe_step(e);
+  std::vector<Vec3> shifted(e.positions()), force, shear;
   std::vector<double> rhs(nu), x, p_cells(nc, 0.0);
   // dV/dt for the velocity v, by central differences (cell volumes are smooth in x).
   for (int u = 0; u < nu; ++u) {
     const int c = system.unknown_cell[u];
-    const CellShape& shape = mesh_->cells.shape[c];
-    for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = centres_prev_[shape.v[k]] + h * v[shape.v[k]];
-    const double plus = cell_volume(shape, shifted, walls_prev_);
-    for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = centres_prev_[shape.v[k]] - h * v[shape.v[k]];
-    const double minus = cell_volume(shape, shifted, walls_prev_);
-    for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = centres_prev_[shape.v[k]];
+    const CellShape& shape = e.pore_mesh().cells.shape[c];
+    for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = e.positions()[shape.v[k]] + h * v[shape.v[k]];
+    const double plus = cell_volume(shape, shifted, e.walls());
+    for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = e.positions()[shape.v[k]] - h * v[shape.v[k]];
+    const double minus = cell_volume(shape, shifted, e.walls());
+    for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = e.positions()[shape.v[k]];
     rhs[u] = -(plus - minus) / (2 * h);
   }
-  linear_.solver->apply_inverse(system, rhs, x, settings.solve_control());
+  e.linear_system().solver->apply_inverse(system, rhs, x, e.settings.solve_control());
   for (int u = 0; u < nu; ++u) p_cells[system.unknown_cell[u]] = x[u];
-  mesh_->cache.apply(p_cells, force);
-  if (mesh_->shear) mesh_->shear->add_velocity_forces(v, settings.viscosity_of_shear(), force, shear);
+  e.pore_mesh().cache.apply(p_cells, force);
+  if (e.pore_mesh().shear) e.pore_mesh().shear->add_velocity_forces(v, e.settings.viscosity_of_shear(), force, shear);
   accel.resize(n);
   for (int k = 0; k < n; ++k) accel[k] = mass[k] > 0 ? Vec3(force[k] / mass[k]) : Vec3::Zero();
 }
 
-double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int iterations, std::vector<Vec3>* mode,
-                                           int* applications) const {
+double viscous_stability_limit(const FlowEngine& e, const std::vector<double>& mass, int iterations,
+                               std::vector<Vec3>* mode, int* applications) {
   if (applications) *applications = 0;
-  check_stability_inputs(mass);
-  const int n = mesh().n_spheres;
-  const int nu = linear_.system.n_unknowns();
-  if (nu == 0 || !linear_.ready()) return HUGE_VAL;
+  check_stability_inputs(e, mass);
+  const int n = e.mesh().n_spheres;
+  const int nu = e.linear_system().system.n_unknowns();
+  if (nu == 0 || !e.linear_system().ready()) return HUGE_VAL;
 
   // The given mode, else a deterministic start with a component along every moving sphere.
   std::vector<Vec3> v(n, Vec3::Zero());
@@ -121,7 +121,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
   std::vector<Vec3> w;
   if (warm) {
     for (int it = 0; it < iterations; ++it) {
-      apply_viscous_operator(mass, v, w);
+      apply_viscous_operator(e, mass, v, w);
       ++applied;
       const double previous = lambda;
       lambda = std::sqrt(dot(w, w));  // |M^-1 V v| for |v| = 1
@@ -138,7 +138,7 @@ double FlowEngine::viscous_stability_limit(const std::vector<double>& mass, int 
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + 1, m);
     Eigen::VectorXcd ritz_vector;
     for (int j = 0; j < m; ++j) {
-      apply_viscous_operator(mass, q[j], w);
+      apply_viscous_operator(e, mass, q[j], w);
       ++applied;
       for (int pass = 0; pass < 2; ++pass)  // Gram-Schmidt twice: orthogonal to round-off
         for (int i = 0; i <= j; ++i) {

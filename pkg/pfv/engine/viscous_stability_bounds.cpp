@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "pfv/engine/flow_engine.hpp"
 #include "pfv/engine/pore_mesh.hpp"
+#include "pfv/engine/viscous_stability.hpp"
 #include "pfv/linalg/refinement.hpp"
 
 namespace pfv {
@@ -62,21 +62,21 @@ Vec3 volume_gradient(const CellShape& shape, int k, std::vector<Vec3>& centre, c
 // spreads a local source over the drainage path, so it sits up to four orders of magnitude above
 // lambda_max on the packings measured: good enough to show a small step safe, never to find the
 // limit. The optional shear term is not covered: with it there is no bound.
-double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) const {
-  check_stability_inputs(mass);
-  if (mesh_->shear) return 0;
-  const PressureSystem& system = linear_.system;
+double viscous_stability_bound(const FlowEngine& e, const std::vector<double>& mass) {
+  check_stability_inputs(e, mass);
+  if (e.pore_mesh().shear) return 0;
+  const PressureSystem& system = e.linear_system().system;
   const int nu = system.n_unknowns();
-  if (nu == 0 || !linear_.ready()) return HUGE_VAL;
+  if (nu == 0 || !e.linear_system().ready()) return HUGE_VAL;
   if (!stieltjes(system)) return 0;
-  const double h = volume_probe_step();
+  const double h = volume_probe_step(e);
   std::vector<double> beta(nu, 0.0);
-  std::vector<Vec3> shifted(centres_prev_);
+  std::vector<Vec3> shifted(e.positions());
   double beta_max = 0;
   for (int u = 0; u < nu; ++u) {
-    const CellShape& shape = mesh_->cells.shape[system.unknown_cell[u]];
+    const CellShape& shape = e.pore_mesh().cells.shape[system.unknown_cell[u]];
     for (int k = 0; k < 4 - shape.n_walls; ++k)
-      if (mass[shape.v[k]] > 0) beta[u] += volume_gradient(shape, k, shifted, walls_prev_, h).cwiseAbs().sum();
+      if (mass[shape.v[k]] > 0) beta[u] += volume_gradient(shape, k, shifted, e.walls(), h).cwiseAbs().sum();
     beta_max = std::max(beta_max, beta[u]);
   }
   if (beta_max == 0) return HUGE_VAL;  // nothing moves any pore: no fluid force, no limit
@@ -96,9 +96,9 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
   constexpr double kMaxScale = 2;
   constexpr int kMaxPasses = 6;
   std::vector<double> z, correction, defect;
-  SolveControl control = settings.solve_control();
-  if (linear_.solver->kind() != SolverKind::kGaussSeidel) control.inverse_tolerance = kTolerance;
-  linear_.solver->apply_inverse(system, beta, z, control);
+  SolveControl control = e.settings.solve_control();
+  if (e.linear_system().solver->kind() != SolverKind::kGaussSeidel) control.inverse_tolerance = kTolerance;
+  e.linear_system().solver->apply_inverse(system, beta, z, control);
   double q = HUGE_VAL;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     residual(system, beta, z, defect);  // beta - G z
@@ -109,17 +109,17 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
     }
     if (q <= kGoodScale) break;
     if (pass + 1 < kMaxPasses) {
-      linear_.solver->apply_inverse(system, defect, correction, control);
+      e.linear_system().solver->apply_inverse(system, defect, correction, control);
       for (int u = 0; u < nu; ++u) z[u] += correction[u];
     }
   }
   if (!(q <= kMaxScale)) return 0;  // G is not the matrix this argument needs, or the solve is poor
-  std::vector<double> z_cells(mesh().n_cells(), 0.0);
+  std::vector<double> z_cells(e.mesh().n_cells(), 0.0);
   for (int u = 0; u < nu; ++u) z_cells[system.unknown_cell[u]] = std::max(z[u], 0.0) * q;
   std::vector<Vec3> rows;
-  mesh_->cache.apply_magnitude(z_cells, rows);
+  e.pore_mesh().cache.apply_magnitude(z_cells, rows);
   double lambda = 0;
-  for (int k = 0; k < mesh().n_spheres; ++k)
+  for (int k = 0; k < e.mesh().n_spheres; ++k)
     if (mass[k] > 0) lambda = std::max(lambda, rows[k].maxCoeff() / mass[k]);
   if (!std::isfinite(lambda))
     throw std::domain_error(
@@ -139,21 +139,21 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
 // Dirichlet cell: the star's total volume is fixed by its boundary and a uniform pressure pushes
 // no sphere, to round-off; checked (else no bound). The loss is the factor 3 and the local
 // problems' closed outer boundary: the bound sits within an order of magnitude of the limit.
-double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass) const {
-  check_stability_inputs(mass);
-  if (mesh_->shear) return 0;
-  const PressureSystem& system = linear_.system;
-  if (system.n_unknowns() == 0 || !linear_.ready()) return HUGE_VAL;
+double viscous_stability_local_bound(const FlowEngine& e, const std::vector<double>& mass) {
+  check_stability_inputs(e, mass);
+  if (e.pore_mesh().shear) return 0;
+  const PressureSystem& system = e.linear_system().system;
+  if (system.n_unknowns() == 0 || !e.linear_system().ready()) return HUGE_VAL;
   if (!stieltjes(system)) return 0;
-  const int n = mesh().n_spheres, nc = mesh().n_cells();
-  const CellGeometry& cg = mesh_->cells;
-  const FacetGeometry& fg = mesh_->facets;
+  const int n = e.mesh().n_spheres, nc = e.mesh().n_cells();
+  const CellGeometry& cg = e.pore_mesh().cells;
+  const FacetGeometry& fg = e.pore_mesh().facets;
   // Per sphere: its unknown cells (with its local vertex index in each) and the throats through it
   // that carry flow (neither side blocked).
   std::vector<int> cell_start(n + 1, 0), facet_start(n + 1, 0);
   const auto flowing = [&](int f) {
     const int a = fg.cell[f][0], b = fg.cell[f][1];
-    return b >= 0 && mesh_->k[f] != 0 && system.source[a] != kBlockedCell && system.source[b] != kBlockedCell;
+    return b >= 0 && e.pore_mesh().k[f] != 0 && !system.source[a].is_blocked() && !system.source[b].is_blocked();
   };
   for (int c = 0; c < nc; ++c)
     if (system.unknown[c] >= 0)
@@ -178,8 +178,8 @@ double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass
           if (v < n) star_facet[next[v]++] = f;
   }
   constexpr double kZeroSum = 1e-6;  // relative to the sum of magnitudes, far above round-off
-  const double h = volume_probe_step();
-  std::vector<Vec3> shifted(centres_prev_);
+  const double h = volume_probe_step(e);
+  std::vector<Vec3> shifted(e.positions());
   std::vector<int> slot(nc, -1), root, part;
   std::vector<char> grounded;
   Eigen::MatrixXd L, rhs;
@@ -200,9 +200,9 @@ double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass
       while (root[i] != i) i = root[i] = root[root[i]];
       return i;
     };
-    for (int e = facet_start[s]; e < facet_start[s + 1]; ++e) {
-      const int f = star_facet[e];
-      const double kf = mesh_->k[f];
+    for (int j = facet_start[s]; j < facet_start[s + 1]; ++j) {
+      const int f = star_facet[j];
+      const double kf = e.pore_mesh().k[f];
       const int a = slot[fg.cell[f][0]], b = slot[fg.cell[f][1]];  // -1: a Dirichlet cell
       if (a >= 0) L(a, a) += kf;
       if (b >= 0) L(b, b) += kf;
@@ -218,10 +218,10 @@ double FlowEngine::viscous_stability_local_bound(const std::vector<double>& mass
     rhs.setZero(m, 6);
     for (int i = 0; i < m; ++i) {
       const auto [c, k] = star_cell[first + i];
-      rhs.block<1, 3>(i, 0) = volume_gradient(cg.shape[c], k, shifted, walls_prev_, h).transpose();
+      rhs.block<1, 3>(i, 0) = volume_gradient(cg.shape[c], k, shifted, e.walls(), h).transpose();
     }
-    const auto cells = mesh_->cache.cells(s);
-    const auto units = mesh_->cache.units(s);
+    const auto cells = e.pore_mesh().cache.cells(s);
+    const auto units = e.pore_mesh().cache.units(s);
     for (std::size_t k = 0; k < cells.size(); ++k)
       if (system.unknown[cells[k]] >= 0) {
         if (slot[cells[k]] < 0) {  // a force from a cell without s: not the structure assumed

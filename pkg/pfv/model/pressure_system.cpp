@@ -12,24 +12,27 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
                                         const std::vector<double>& storage, const CellConditions& cells) {
   const int nc = mesh.n_cells();
   PressureSystem s;
-  s.source.assign(nc, kUnknownCell);
+  s.source.assign(nc, BoundarySource::unknown());
   for (int c = 0; c < nc; ++c)
-    for (int v : mesh.cell_vertices[c])  // later walls win, as in YADE
-      if (mesh.is_wall(v) && bc.is_pressure[mesh.wall_of(v)]) s.source[c] = std::max(s.source[c], mesh.wall_of(v));
+    for (int v : mesh.cell_vertices[c]) {  // later walls win, as in YADE
+      if (!mesh.is_wall(v) || !bc.is_pressure[mesh.wall_of(v)]) continue;
+      const int w = mesh.wall_of(v);
+      if (!s.source[c].is_wall() || w > s.source[c].index) s.source[c] = BoundarySource::wall(w);
+    }
   for (std::size_t i = 0; i < imposed_cells.size(); ++i)
-    if (imposed_cells[i] >= 0) s.source[imposed_cells[i]] = kWallCount + static_cast<int>(i);
+    if (imposed_cells[i] >= 0) s.source[imposed_cells[i]] = BoundarySource::imposed_point(static_cast<int>(i));
   if (!cells.pressure.empty())
     for (int c = 0; c < nc; ++c) {
-      if (cells.pressure[c] == CellPressure::kImposed) s.source[c] = kCellImposedSource;
-      if (cells.pressure[c] == CellPressure::kFree) s.source[c] = kUnknownCell;
+      if (cells.pressure[c] == CellPressure::kImposed) s.source[c] = BoundarySource::cell_imposed();
+      if (cells.pressure[c] == CellPressure::kFree) s.source[c] = BoundarySource::unknown();
     }
   if (!cells.blocked.empty())
     for (int c = 0; c < nc; ++c)
-      if (cells.blocked[c]) s.source[c] = kBlockedCell;
+      if (cells.blocked[c]) s.source[c] = BoundarySource::blocked();
 
   s.unknown.assign(nc, -1);
   for (int c = 0; c < nc; ++c)
-    if (s.source[c] == kUnknownCell) {
+    if (s.source[c].is_unknown()) {
       s.unknown[c] = static_cast<int>(s.unknown_cell.size());
       s.unknown_cell.push_back(c);
     }
@@ -49,7 +52,7 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
   for (int f = 0; f < facets.size(); ++f) {
     const int a = facets.cell[f][0], b = facets.cell[f][1];
     if (b < 0) continue;
-    const double kf = s.source[a] == kBlockedCell || s.source[b] == kBlockedCell ? 0.0 : k[f];
+    const double kf = s.source[a].is_blocked() || s.source[b].is_blocked() ? 0.0 : k[f];
     s.adj_cell[fill[a]] = b;
     s.adj_k[fill[a]++] = kf;
     s.adj_cell[fill[b]] = a;
@@ -82,7 +85,7 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
   const int isolated = static_cast<int>(std::count(reached.begin(), reached.end(), 0));
   if (isolated > 0) {
     const bool none =
-        std::none_of(s.source.begin(), s.source.end(), [](int x) { return x >= 0 || x == kCellImposedSource; });
+        std::none_of(s.source.begin(), s.source.end(), [](const BoundarySource& x) { return x.imposes_pressure(); });
     throw std::domain_error(none ? "singular pressure system: no boundary has an imposed pressure (set "
                                    "bndCondIsPressure on at least one wall, or imposePressure somewhere)"
                                  : "singular pressure system: " + std::to_string(isolated) +
@@ -157,9 +160,11 @@ void index_rows(PressureSystem& s) {
 
 void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc, std::vector<double>& p) {
   for (std::size_t c = 0; c < s.source.size(); ++c) {
-    const int src = s.source[c];
-    if (src < 0) continue;
-    p[c] = src < kWallCount ? bc.value[src] : bc.imposed_pressure[src - kWallCount].value;
+    const BoundarySource& src = s.source[c];
+    if (src.is_wall())
+      p[c] = bc.value[src.index];
+    else if (src.is_imposed_point())
+      p[c] = bc.imposed_pressure[src.index].value;
   }
 }
 

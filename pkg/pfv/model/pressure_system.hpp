@@ -10,22 +10,18 @@
 #include <vector>
 
 #include "pfv/model/boundary_conditions.hpp"
+#include "pfv/model/boundary_source.hpp"
 #include "pfv/model/cell_conditions.hpp"
 #include "triangulation/mesh.hpp"
 #include "triangulation/pore_geometry.hpp"
 
 namespace pfv {
 
-// PressureSystem::source of a cell that is no Dirichlet cell of a wall or an imposed point.
-constexpr int kUnknownCell = -1;        // an unknown
-constexpr int kCellImposedSource = -2;  // imposed on the cell itself: its pressure is kept
-constexpr int kBlockedCell = -3;        // blocked: no unknown, no flux through its throats
-
 struct PressureSystem {
   // Per cell.
-  std::vector<int> unknown;      // index among unknowns, -1 for any other cell
-  std::vector<int> source;       // Dirichlet source: wall w, or kWallCount + imposed point; else one of the above
-  std::vector<double> diagonal;  // sum of k over the cell's throats
+  std::vector<int> unknown;            // index among unknowns, -1 for any other cell
+  std::vector<BoundarySource> source;  // where its pressure comes from (boundary_source.hpp)
+  std::vector<double> diagonal;        // sum of k over the cell's throats
   // Cell adjacency through throats, both directions (CSR); k is 0 through a blocked cell's throats.
   std::vector<int> adj_start, adj_cell;
   std::vector<double> adj_k;

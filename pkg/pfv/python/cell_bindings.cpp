@@ -8,6 +8,7 @@
 #include <cstring>
 #include <string>
 
+#include "pfv/engine/flow_queries.hpp"
 #include "pfv/linalg/cholmod_solver.hpp"
 #include "pfv/model/cell_queries.hpp"
 #include "pfv/python/shared_engine.hpp"
@@ -31,10 +32,10 @@ struct LastPacking {
   std::vector<double> radii;
   Packing packing;
   LastPacking(const SharedEngine& e, const Array& r)
-      : radii(to_vector(r, "radii")), packing{e.last_centres(), radii, e.walls()} {
-    if (e.last_centres().size() != static_cast<std::size_t>(e.mesh().n_spheres))
+      : radii(to_vector(r, "radii")), packing{e.positions(), radii, e.walls()} {
+    if (e.positions().size() != static_cast<std::size_t>(e.mesh().n_spheres))
       throw py::value_error("the mesh has no positions yet (its step did not complete)");
-    if (radii.size() != e.last_centres().size())
+    if (radii.size() != e.positions().size())
       throw py::value_error("radii: one per sphere of the mesh (" + std::to_string(e.mesh().n_spheres) + ")");
   }
 };
@@ -58,10 +59,10 @@ void bind_cells(EngineClass& engine) {
   engine
       .def("cell_barycenter", exclusive([](const SharedEngine& e, int id) {
              check_cell(e, id);
-             if (e.last_centres().size() != static_cast<std::size_t>(e.mesh().n_spheres))
+             if (e.positions().size() != static_cast<std::size_t>(e.mesh().n_spheres))
                throw py::value_error("the mesh has no positions yet (its step did not complete)");
              const std::vector<double> no_radii;
-             const Packing packing{e.last_centres(), no_radii, e.walls()};
+             const Packing packing{e.positions(), no_radii, e.walls()};
              return triple(cell_barycenter(e.cells().shape[id], packing));
            }),
            py::arg("id"), "Mean of the cell's vertices at the last step's positions (walls: see cell_queries.hpp).")
@@ -86,10 +87,10 @@ void bind_cells(EngineClass& engine) {
              return out;
            }),
            "(n_cells, 4): the cell across the facet opposite each local vertex, -1 for none.")
-      .def("last_positions", exclusive([](const SharedEngine& e) { return points_to_array(meshed(e).last_centres()); }),
+      .def("last_positions", exclusive([](const SharedEngine& e) { return points_to_array(meshed(e).positions()); }),
            "The sphere centres of the last step.")
       .def("system_times", exclusive([](const SharedEngine& e) {
-             const StageTimes& t = meshed(e).system_times();
+             const StageTimes& t = system_times(meshed(e));
              py::dict d;
              d["assembly"] = t.assembly;
              d["analysis"] = t.analysis;
@@ -114,7 +115,7 @@ void bind_cells(EngineClass& engine) {
              meshed(e);
              if (cond < 0 || cond >= static_cast<int>(e.bc.imposed_pressure.size()))
                throw py::index_error("no imposed pressure with index " + std::to_string(cond));
-             return e.locate(e.bc.imposed_pressure[cond].position);
+             return locate(e, e.bc.imposed_pressure[cond].position);
            }),
            py::arg("cond"), "The cell of imposed pressure number cond on the current mesh (-1: none).")
       .def("set_cell_imposed", exclusive([](SharedEngine& e, int id, bool imposed) {
@@ -124,7 +125,7 @@ void bind_cells(EngineClass& engine) {
            py::arg("id"), py::arg("imposed"))
       .def("cell_imposed", exclusive([](const SharedEngine& e, int id) {
              check_cell(e, id);
-             return e.cell_imposed(id);
+             return cell_imposed(e, id);
            }),
            py::arg("id"))
       .def("set_cell_pressure", exclusive([](SharedEngine& e, int id, double p) {

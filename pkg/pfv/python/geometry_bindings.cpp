@@ -26,14 +26,14 @@ void bind_geometry(EngineClass& engine) {
       .def("cell_velocities", exclusive([](const SharedEngine& e) {
              const CellConditions& blocked = meshed(e).cell_conditions();
              const int n = e.mesh().n_spheres;
-             if (e.last_centres().size() != static_cast<std::size_t>(n))
+             if (e.positions().size() != static_cast<std::size_t>(n))
                throw py::value_error("the mesh has no positions yet (its step did not complete)");
              std::vector<double> k = e.conductances();
              if (!blocked.blocked.empty())  // no flux through a blocked cell's throats
                for (int f = 0; f < e.facets().size(); ++f)
                  for (int c : e.facets().cell[f])
                    if (c >= 0 && blocked.is_blocked(c)) k[f] = 0;
-             return points_to_array(mean_cell_velocities(e.cells(), e.facets(), k, e.pressure(), e.last_centres(), n));
+             return points_to_array(mean_cell_velocities(e.cells(), e.facets(), k, e.pressure(), e.positions(), n));
            }),
            "Mean fluid velocity of every cell from the throat fluxes of the last step (cell_velocity.hpp).");
 }

@@ -11,6 +11,27 @@
 #include "triangulation/pore_geometry.hpp"
 
 namespace pfv::python {
+namespace {
+
+// The integer Python reads for a cell's pressure source (cell_sources below). A new kind of
+// BoundarySource needs a code here.
+int source_code(const BoundarySource& source) {
+  switch (source.kind) {
+    case BoundarySource::Kind::kWall:
+      return source.index;
+    case BoundarySource::Kind::kImposedPoint:
+      return kWallCount + source.index;
+    case BoundarySource::Kind::kCellImposed:
+      return -2;
+    case BoundarySource::Kind::kBlocked:
+      return -3;
+    case BoundarySource::Kind::kUnknown:
+      break;
+  }
+  return -1;
+}
+
+}  // namespace
 
 void bind_output(EngineClass& engine) {
   engine
@@ -29,10 +50,12 @@ void bind_output(EngineClass& engine) {
            "Total volume of every cell (tetrahedron or wall prism) at positions() and walls(); cell_volumes() is\n"
            "the volume at the last remesh.")
       .def("cell_sources", exclusive([](const SharedEngine& e) {
-             const std::vector<int>& source = meshed(e).system().source;
+             const std::vector<BoundarySource>& source = meshed(e).system().source;
              if (source.size() != static_cast<std::size_t>(e.mesh().n_cells()))
                throw py::value_error("the linear system does not belong to the current mesh (run a step first)");
-             return vector_to_array(source);
+             std::vector<int> code(source.size());
+             for (std::size_t c = 0; c < source.size(); ++c) code[c] = source_code(source[c]);
+             return vector_to_array(code);
            }),
            "Pressure source of every cell: wall w (0..5) or 6 + k (imposed pressure k) for a cell whose pressure\n"
            "is imposed (a Dirichlet cell of the system), -1 for a cell whose pressure is solved for.")

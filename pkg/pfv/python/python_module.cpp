@@ -15,6 +15,8 @@
 #endif
 
 #include "pfv/engine/flow_engine.hpp"
+#include "pfv/engine/flow_queries.hpp"
+#include "pfv/engine/viscous_stability.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/model/force_parts.hpp"
 #include "pfv/python/shared_engine.hpp"
@@ -88,7 +90,7 @@ int add_point_condition(FlowEngine& e, std::vector<PointCondition>& list, const 
     list.pop_back();
     throw;
   }
-  if (e.has_mesh() && e.locate(c.position) < 0) {
+  if (e.has_mesh() && locate(e, c.position) < 0) {
     list.pop_back();
     throw py::value_error("the point " + describe(c.position) +
                           " lies in no pore cell (outside the walls or the packing)");
@@ -96,13 +98,13 @@ int add_point_condition(FlowEngine& e, std::vector<PointCondition>& list, const 
   return static_cast<int>(list.size()) - 1;
 }
 
-// A const method of the sphere masses (the stability bounds), run without the GIL.
-template <double (FlowEngine::*method)(const std::vector<double>&) const>
+// A function of the engine and the sphere masses (the stability bounds), run without the GIL.
+template <double (*function)(const FlowEngine&, const std::vector<double>&)>
 auto of_masses() {
   return exclusive([](const SharedEngine& e, const Array& mass) {
     auto m = to_vector(mass, "masses");
     py::gil_scoped_release release;
-    return (e.*method)(m);
+    return function(e, m);
   });
 }
 
@@ -218,7 +220,7 @@ PYBIND11_MODULE(_core, m) {
           "The multigrid V-cycle's smoother: gauss_seidel (default; symmetric l1-scaled sweeps on the way down and "
           "up), jacobi (l1-scaled; cheaper for a fixed skeleton) or split_gauss_seidel (one forward sweep down, one "
           "backward sweep up); rebuilds the hierarchy at the next step.")
-      .def_property_readonly("solver_choice", exclusive([](const SharedEngine& e) { return e.solver_choice(); }),
+      .def_property_readonly("solver_choice", exclusive([](const SharedEngine& e) { return solver_choice(e); }),
                              "The current system's solver and why; empty before the first step.")
       .def_property("tolerance", get_setting(&EngineSettings::tolerance), set_setting(&EngineSettings::tolerance))
       .def_property("relax", get_setting(&EngineSettings::relax), set_setting(&EngineSettings::relax))
@@ -260,7 +262,7 @@ PYBIND11_MODULE(_core, m) {
           "AMD then METIS).")
       .def("reduced_precision_factor",
            exclusive([](const SharedEngine& e) { return e.cholesky() && e.cholmod().reduced_precision(); }))
-      .def("refinement_contraction", exclusive(&FlowEngine::refinement_contraction))
+      .def("refinement_contraction", exclusive([](const SharedEngine& e) { return refinement_contraction(e); }))
       .def("factor_nonzeros",
            exclusive([](const SharedEngine& e) { return e.cholesky() ? e.cholmod().factor_nonzeros() : 0.0; }))
       .def("factor_flops",
@@ -289,10 +291,10 @@ PYBIND11_MODULE(_core, m) {
       .def_property("shear_viscosity", get_setting(&EngineSettings::shear_viscosity),
                     set_setting(&EngineSettings::shear_viscosity),
                     "The viscosity of the shear term when positive (0, the default: viscosity); a PFV extension.")
-      .def("remesh_pending", exclusive(&FlowEngine::remesh_pending))
+      .def("remesh_pending", exclusive([](const SharedEngine& e) { return e.remesher().pending(); }))
       .def("wait_for_remesh", exclusive([](const SharedEngine& e) {
              py::gil_scoped_release release;
-             e.wait_for_remesh();
+             e.remesher().wait();
            }))
       .def_property("mesh_update_interval", get_setting(&EngineSettings::mesh_update_interval),
                     set_setting(&EngineSettings::mesh_update_interval))
@@ -406,13 +408,13 @@ PYBIND11_MODULE(_core, m) {
       .def("viscous_stability_limit", exclusive([](const SharedEngine& e, const Array& mass, int iterations) {
              auto m = to_vector(mass, "masses");
              py::gil_scoped_release release;
-             return e.viscous_stability_limit(m, iterations);
+             return viscous_stability_limit(e, m, iterations);
            }),
            py::arg("masses"), py::arg("iterations") = 40)
-      .def("viscous_stability_bound", of_masses<&FlowEngine::viscous_stability_bound>(), py::arg("masses"),
+      .def("viscous_stability_bound", of_masses<&viscous_stability_bound>(), py::arg("masses"),
            "A certified lower bound on viscous_stability_limit for about one solve, up to four orders of\n"
            "magnitude below it; 0 when there is none (viscous shear on).")
-      .def("viscous_stability_local_bound", of_masses<&FlowEngine::viscous_stability_local_bound>(), py::arg("masses"),
+      .def("viscous_stability_local_bound", of_masses<&viscous_stability_local_bound>(), py::arg("masses"),
            "A certified lower bound on viscous_stability_limit from small problems around each sphere, within an\n"
            "order of magnitude of it; 0 when there is none (viscous shear on).")
       .def("viscous_stability_mode",
@@ -424,7 +426,7 @@ PYBIND11_MODULE(_core, m) {
              int applications = 0;
              {
                py::gil_scoped_release release;
-               limit = e.viscous_stability_limit(m, iterations, &mode, &applications);
+               limit = viscous_stability_limit(e, m, iterations, &mode, &applications);
              }
              return py::make_tuple(limit, points_to_array(mode), applications);
            }),
@@ -466,14 +468,16 @@ PYBIND11_MODULE(_core, m) {
       .def("n_cells", exclusive([](const SharedEngine& e) { return e.has_mesh() ? e.mesh().n_cells() : 0; }))
       .def("boundary_flux", exclusive([](const SharedEngine& e, int w) {
              check_wall(w);
-             return e.boundary_flux(w);
+             return boundary_flux(e, w);
            }))
-      .def("imposed_flux_total", exclusive(&FlowEngine::imposed_flux_total))
-      .def("volume_rate_total", exclusive(&FlowEngine::volume_rate_total))
-      .def("average_pressure", exclusive(&FlowEngine::average_pressure))
-      .def("average_slice_pressure", exclusive(&FlowEngine::average_slice_pressure))
+      .def("imposed_flux_total", exclusive([](const SharedEngine& e) { return imposed_flux_total(e); }))
+      .def("volume_rate_total", exclusive([](const SharedEngine& e) { return volume_rate_total(e); }))
+      .def("average_pressure", exclusive([](const SharedEngine& e) { return average_pressure(e); }))
+      .def("average_slice_pressure", exclusive([](const SharedEngine& e, int axis, double position) {
+             return average_slice_pressure(e, axis, position);
+           }))
       .def("locate", exclusive([](const SharedEngine& e, const std::array<double, 3>& x) {
-             return e.locate(Vec3(x[0], x[1], x[2]));
+             return locate(e, Vec3(x[0], x[1], x[2]));
            }))
       .def("cell_pressure", exclusive([](const SharedEngine& e, int id) {
              check_cell(e, id);
@@ -492,7 +496,7 @@ PYBIND11_MODULE(_core, m) {
              check_cell(e, id);
              return meshed(e).cells().fluid_volume[id];
            }))
-      .def("metis_used", exclusive(&FlowEngine::metis_used))
+      .def("metis_used", exclusive([](const SharedEngine& e) { return metis_used(e); }))
       .def("hidden_spheres",
            exclusive([](const SharedEngine& e) { return e.has_mesh() ? e.mesh().hidden_spheres : std::vector<int>{}; }))
       .def_property_readonly("remesh_count", exclusive(&FlowEngine::remesh_count))
@@ -504,7 +508,7 @@ PYBIND11_MODULE(_core, m) {
                              "the step runs on with signed volumes (mass conserved) until the scheduled remesh.")
       .def_property_readonly("inverted_volume_fraction", exclusive(&FlowEngine::inverted_volume_fraction),
                              "The part of the meshed volume inverted_cells hold.")
-      .def_property_readonly("mesh_viscosity", exclusive(&FlowEngine::mesh_viscosity),
+      .def_property_readonly("mesh_viscosity", exclusive([](const SharedEngine& e) { return mesh_viscosity(e); }),
                              "The viscosity of the current mesh's conductances.")
       .def_property_readonly("system_builds", exclusive(&FlowEngine::system_builds))
       .def_property_readonly("sweeps", exclusive([](const SharedEngine& e) { return e.last_solve().sweeps; }),
@@ -517,7 +521,8 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("refinement_passes",
                              exclusive([](const SharedEngine& e) { return e.last_solve().refinement_passes; }),
                              "Refinement passes of the last solve with a 32-bit factor.")
-      .def_property_readonly("accumulated_strain", exclusive(&FlowEngine::accumulated_strain))
+      .def_property_readonly("accumulated_strain",
+                             exclusive([](const SharedEngine& e) { return e.remesher().strain(); }))
       .def("walls", exclusive([](const SharedEngine& e) { return e.walls().coord; }))
       .def("remesh_times", exclusive([](const SharedEngine& e) { return times_dict(e.remesh_times()); }))
       .def("step_times", exclusive([](const SharedEngine& e) { return times_dict(e.step_times()); }));

@@ -203,7 +203,7 @@ def clumps():
     O.bodies.clump([a, b])
     O.run(1, True)
     check("convertClumps=True: the clump is one vertex fewer than its members", flow.nCells() > 0
-          and len(flow._stepped.ids) == len(plain._stepped.ids) - 1)
+          and len(flow._bodies.stepped.ids) == len(plain._bodies.stepped.ids) - 1)
 
 
 def main():

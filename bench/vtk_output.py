@@ -93,7 +93,7 @@ def profile(flow: PfvFlowEngine, folder: str, with_boundaries: bool) -> dict[str
     """PFV's saveVtk in its three parts (the same calls as FlowEngine.saveVtk)."""
     t0 = time.perf_counter()
     with flow._lock:
-        scan = flow._stepped
+        scan = flow._bodies.stepped
         state = _vtk_output.read_state(flow.core, scan.ids, scan.radii, scan.wall_ids, O.time)
     t1 = time.perf_counter()
     pores, spheres = _vtk_output.pore_grid(state, with_boundaries), _vtk_output.sphere_grid(state)

@@ -1,7 +1,8 @@
-"""The cell members of pfv.FlowEngine (pfv/_cell_interface.py) on their own: errors before the first
-step and for bad arguments, the attributes YADE's scripts set (accepted, validated, read back), the
-per-step reports, the outputs that only print, convertClumps=False against the same packing without
-clumps, and what a remesh does to the conditions set on cells.
+"""The cell members of pfv.FlowEngine (pfv/_cell_geometry.py, _flow_queries.py, _cell_conditions.py) on
+their own: errors before the first step and for bad arguments, the attributes YADE's scripts set
+(accepted, validated, read back), the per-step reports, the outputs that only print,
+convertClumps=False against the same packing without clumps, and what a remesh does to the
+conditions set on cells.
 
     yade-double -n -x tests/yade/test_cell_interface_input.py      (exit 0 = pass)
 """
@@ -203,7 +204,7 @@ def clumps():
     O.bodies.clump([a, b])
     O.run(1, True)
     check("convertClumps=True: the clump is one vertex fewer than its members", flow.nCells() > 0
-          and len(flow._stepped.ids) == len(plain._stepped.ids) - 1)
+          and len(flow._bodies.stepped.ids) == len(plain._bodies.stepped.ids) - 1)
 
 
 def main():

@@ -1,4 +1,5 @@
-"""YADE's cell members (pfv/_cell_interface.py) side by side with YADE's FlowEngine on the same scenes.
+"""YADE's cell members (pfv/_cell_geometry.py, _flow_queries.py, _cell_conditions.py) side by side with
+YADE's FlowEngine on the same scenes.
 
 The 1000-sphere permeameter (frozen, no-slip walls so that the two engines' conductances agree), flow
 along y. Both engines triangulate the same spheres with the same regular triangulation, so the cells

@@ -86,7 +86,7 @@ pfv_flow, f_pfv, a_pfv = run(lambda: FlowEngine(label="flow"), clumps)
 q_pfv = pfv_flow.getBoundaryFlux(2)
 rb.check("20 clumps built", len(clumps) == 20)
 
-scan = pfv_flow._stepped
+scan = pfv_flow._bodies.stepped
 radius = dict(zip(scan.ids.tolist(), scan.radii.tolist()))
 rb.check("clumps are vertices, their members are not", all(c in radius for c in clumps)
          and not any(m in radius for p in pairs for m in p))
@@ -117,7 +117,7 @@ flow = FlowEngine(label="flow", convertClumps=False)
 rb.scenes.configure_flow(flow, axis=1, dp=1.0, slipBoundary=False)
 rb.scenes.insert_flow(flow)
 rb.run(1)
-ids = set(flow._stepped.ids.tolist())
+ids = set(flow._bodies.stepped.ids.tolist())
 rb.check("convertClumps=False: the members are the vertices", all(m in ids for p in pairs for m in p)
          and not any(c in ids for c in clumps))
 rb.report("clump")

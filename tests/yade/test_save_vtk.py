@@ -88,7 +88,7 @@ def cells(grid):
 def engine_state(flow):
     """The engine's values that a snapshot taken now must hold."""
     core = flow.core
-    scan = flow._stepped
+    scan = flow._bodies.stepped
     ids = scan.ids
     return dict(time=O.time, pressure=core.pressure(), velocity=core.cell_velocities(),
                 fluid_volume=core.cell_fluid_volumes(), volume=core.current_cell_volumes(),

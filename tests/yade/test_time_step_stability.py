@@ -192,7 +192,7 @@ check(raised is not None and "exceeds the coupled stability limit" in raised,
 check(O.iter == it0, "strict_time_step: O.iter did not advance (%d -> %d)" % (it0, O.iter))
 check(not [w for w in caught if issubclass(w.category, TimeStepWarning)], "strict_time_step: raises instead of warning")
 try:
-    flow._check_time_step(O.dt)
+    flow._time_step.check(O.dt)
     direct = None
 except ValueError as e:
     direct = str(e)

@@ -44,7 +44,7 @@ def run(use_pack):
     O.loadTmp("reader")
     flow = FlowEngine()
     scenes.configure_flow(flow, axis=1, dp=1.0e3, useSolver=3, meshUpdateInterval=1000000, defTolerance=0)
-    object.__setattr__(flow, "_use_sphere_pack", use_pack)
+    flow._bodies.use_sphere_pack = use_pack
     scenes.insert_flow(flow)
     start = np.array([tuple(b.state.pos) for b in O.bodies if isinstance(b.shape, Sphere)])
     steps = []
@@ -53,12 +53,12 @@ def run(use_pack):
             O.bodies.erase(victim)
         O.run(1, True)
         steps.append(dict(p=np.array(flow.core.pressure()), f=np.array(flow.core.forces()),
-                          remeshes=flow.core.remesh_count, spheres=len(flow._scan.ids)))
-    centres = flow._read_positions()[0]
-    python = np.array([tuple(O.bodies[int(i)].state.pos) for i in flow._scan.ids])
+                          remeshes=flow.core.remesh_count, spheres=len(flow._bodies.scan.ids)))
+    centres = flow._bodies.read_positions()[0]
+    python = np.array([tuple(O.bodies[int(i)].state.pos) for i in flow._bodies.scan.ids])
     moved = np.abs(python[:ERASE_AT] - start[:ERASE_AT]).max()
     return dict(flow=flow, source=flow.position_source, steps=steps, centres=centres, python=python,
-                moved=moved, ids=list(flow._scan.ids))
+                moved=moved, ids=list(flow._bodies.scan.ids))
 
 
 check(_core.sphere_pack_size(SpherePack()) == 0,

@@ -1,6 +1,6 @@
 // Single cells of the current mesh, by index (valid until the next remesh): their geometry,
 // fluxes and stored volumes, and the conditions set on them (YADE's cell methods; the YADE
-// names are in pfv/_cell_interface.py).
+// names are in pfv/_cell_geometry.py, _flow_queries.py and _cell_conditions.py).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

@@ -20,8 +20,6 @@
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/model/force_parts.hpp"
 #include "pfv/python/shared_engine.hpp"
-#include "pfv/python/yade_force_bridge.hpp"
-#include "pfv/python/yade_sphere_pack.hpp"
 #include "pfv/snapshot/snapshot.hpp"
 
 namespace py = pybind11;
@@ -125,30 +123,8 @@ PYBIND11_MODULE(_core, m) {
 #endif
   });
 
-  // The per-step bridge to YADE (yade_force_bridge.hpp).
-  py::class_<YadeForceBridge>(m, "YadeForceBridge")
-      .def(py::init<py::object, const py::array_t<long long>&, const py::array_t<long long>&>(),
-           py::arg("vector3_type"), py::arg("ids"), py::arg("rows"))
-      .def(
-          "apply",
-          [](const YadeForceBridge& b, py::handle add, const SharedEngine& engine) {
-            const EngineLock lock(engine);
-            const std::vector<Vec3>& f = engine.forces();
-            static_assert(sizeof(Vec3) == 3 * sizeof(double), "rows of three doubles");
-            b.apply(add, f.empty() ? nullptr : f.front().data(), f.size());
-          },
-          py::arg("add"), py::arg("engine"), "The forces of an Engine (its forces(), without the copy).")
-      .def("apply", py::overload_cast<py::handle, const YadeForceBridge::Forces&>(&YadeForceBridge::apply, py::const_),
-           py::arg("add"), py::arg("forces"))
-      .def_property_readonly("writes_in_place", &YadeForceBridge::writes_in_place)
-      .def_property_readonly("calls_yade_directly", &YadeForceBridge::calls_yade_directly)
-      .def("__len__", &YadeForceBridge::size);
-
-  // The sphere centres from a yade.pack.SpherePack after fromSimulation() (yade_sphere_pack.hpp).
-  m.def(
-      "sphere_pack_size", [](py::handle pack) { return sphere_pack_size(pack); }, py::arg("pack"));
-  m.def("gather_sphere_pack", &gather_sphere_pack, py::arg("pack"), py::arg("index"), py::arg("centres"),
-        py::arg("radii") = py::none(), py::arg("expected_size") = -1);
+  // The code that reads YADE's objects in place (pfv/yade_bridge/).
+  bind_yade_bridge(m);
 
   // One axis of the sphere centres straight from YADE's coordinate list for that axis
   // (yade._utils.coordsAndDisplacements(axis)[0], all bodies): no numpy round trip. One axis at

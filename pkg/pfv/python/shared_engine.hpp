@@ -135,5 +135,7 @@ void bind_geometry(EngineClass& engine);     // geometry_bindings.cpp
 void bind_output(EngineClass& engine);       // output_bindings.cpp
 void bind_persistence(EngineClass& engine);  // persistence_bindings.cpp
 void bind_cells(EngineClass& engine);        // cell_bindings.cpp
+// The module's YADE bridge classes and functions (yade_bridge_bindings.cpp).
+void bind_yade_bridge(py::module_& m);
 
 }  // namespace pfv::python

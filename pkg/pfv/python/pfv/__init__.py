@@ -6,6 +6,9 @@ The C++ engine alone is ``pfv.Engine`` (usable without YADE).
 from ._core import Engine, set_num_threads, get_max_threads  # noqa: F401
 from ._time_step import TimeStepWarning  # noqa: F401  (no YADE needed)
 from . import waves  # noqa: F401  (time-dependent boundary pressures; no YADE needed)
+from ._yade_version import check_running_yade
+
+check_running_yade()  # inside another YADE than the bridge's: ImportError naming both versions
 
 try:
     from .flow_engine import FlowEngine  # noqa: F401  (needs YADE's Python modules)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import ast
 import math
 import numbers
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
@@ -194,3 +194,17 @@ def as_number(name: str, value: Any) -> float:
     if not math.isfinite(value):
         raise ValueError(f"{name} must be finite, got {value!r}")
     return value
+
+
+def as_index(name: str, value: Any) -> int:
+    """An integer index (a bool or a float is refused, as YADE's converters refuse them)."""
+    if isinstance(value, (bool, float)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {value!r}")
+    return int(value)
+
+
+def as_numbers(name: str, value: Any) -> list[float]:
+    """A sequence of finite numbers."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, Sequence | np.ndarray):
+        raise TypeError(f"{name} must be a sequence of numbers, got {value!r}")
+    return [as_number(f"{name}[{i}]", v) for i, v in enumerate(value)]

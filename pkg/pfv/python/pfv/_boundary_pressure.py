@@ -1,44 +1,42 @@
-"""Time-dependent boundary pressures, as a mixin of ``pfv.FlowEngine``: YADE's waveAction and
-PFV's general form ``set_boundary_pressure(wall, p)`` (pfv.waves, doc/waves.md).
+"""Pressures on a wall beyond its bndCondValue, a part of ``pfv.FlowEngine``: YADE's waveAction and
+its pressure profile on ymax (boundaryXPos, boundaryPressure), and PFV's general form
+``set_boundary_pressure(wall, p)`` (pfv.waves, doc/waves.md).
 
-Both hand the core one function of the positions of a pressure wall's Dirichlet cells, which the
-core calls once per step after any remesh (pfv/model/boundary_conditions.hpp, PressureField).
-Its values replace the wall's bndCondValue in the right-hand side only: a time-dependent load
+waveAction and set_boundary_pressure hand the core one function of the positions of a pressure
+wall's Dirichlet cells, which the core calls once per step after any remesh
+(pfv/model/boundary_conditions.hpp, PressureField); the profile is a table the core interpolates.
+Their values replace the wall's bndCondValue in the right-hand side only: a time-dependent load
 never rebuilds the system. Without a load nothing here runs during a step.
 """
 from __future__ import annotations
 
 import math
 import weakref
+from collections.abc import Sequence
 from typing import Any, Callable
 
 import numpy as np
 
 from . import _attributes as attributes
-from ._locking import exclusive
 
-# Python-side state of the mixin (plain instance attributes, not YADE attributes).
-FIELD_INTERNAL = frozenset({
-    "_wave_action",        # waveAction
-    "_sine_magnitude",     # sineMagnitude
-    "_sine_average",       # sineAverage
-    "_pressure_function",  # (wall, p) of set_boundary_pressure, or None
-    "_field_time",         # O.time of the step being computed
-    "_field_walls",        # the six boundary coordinates of that step
-})
 WALL_NAMES = ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax")
-_YADE_WAVE_WALL = 3  # YADE's waveAction loads ymax
+_YADE_WAVE_WALL = 3  # YADE's waveAction loads ymax and its profile lies on ymax
 
 
 class BoundaryPressure:
-    """waveAction, sineMagnitude, sineAverage and set_boundary_pressure (mixed into pfv.FlowEngine)."""
+    """waveAction, sineMagnitude, sineAverage, boundaryXPos, boundaryPressure and set_boundary_pressure
+    of the engine whose pfv.Engine is `core`."""
 
-    _wave_action = False
-    _sine_magnitude = 0.0
-    _sine_average = 0.0
-    _pressure_function: tuple[int, Callable[..., Any]] | None = None
-    _field_time = 0.0
-    _field_walls = (0.0, 1.0, 0.0, 1.0, 0.0, 1.0)
+    def __init__(self, core: Any) -> None:
+        self._core = core
+        self._wave_action = False
+        self._sine_magnitude = 0.0
+        self._sine_average = 0.0
+        self._function: tuple[int, Callable[..., Any]] | None = None  # (wall, p), or None
+        self._time = 0.0  # O.time of the step being computed
+        self._walls = (0.0, 1.0, 0.0, 1.0, 0.0, 1.0)  # the six boundary coordinates of that step
+        self._x_pos: tuple[float, ...] = ()  # boundaryXPos
+        self._pressures: tuple[float, ...] = ()  # boundaryPressure
 
     # -- YADE's attributes ------------------------------------------------------------------------
     @property
@@ -54,10 +52,10 @@ class BoundaryPressure:
         value = attributes.as_flag("waveAction", value)
         if value == self._wave_action:
             return
-        if value and self._pressure_function is not None:
+        if value and self._function is not None:
             raise ValueError("waveAction: a boundary pressure function is set (set_boundary_pressure); clear it "
                              "first (clear_boundary_pressure), the engine takes one time-dependent load")
-        object.__setattr__(self, "_wave_action", value)
+        self._wave_action = value
         self._install((_YADE_WAVE_WALL, self._yade_wave) if value else None)
 
     @property
@@ -67,7 +65,7 @@ class BoundaryPressure:
 
     @sineMagnitude.setter
     def sineMagnitude(self, value: float) -> None:
-        object.__setattr__(self, "_sine_magnitude", attributes.as_number("sineMagnitude", value))
+        self._sine_magnitude = attributes.as_number("sineMagnitude", value)
 
     @property
     def sineAverage(self) -> float:
@@ -76,11 +74,39 @@ class BoundaryPressure:
 
     @sineAverage.setter
     def sineAverage(self, value: float) -> None:
-        object.__setattr__(self, "_sine_average", attributes.as_number("sineAverage", value))
+        self._sine_average = attributes.as_number("sineAverage", value)
 
     def _yade_wave(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, t: float) -> np.ndarray:
-        walls = self._field_walls
+        walls = self._walls
         return self._sine_average + self._sine_magnitude * np.cos(math.pi * (x - walls[0]) / (walls[1] - walls[0]))
+
+    # -- YADE's pressure profile on ymax ------------------------------------------------------------
+    @property
+    def boundaryXPos(self) -> list[float]:
+        """x of the points of the pressure profile on ymax (see boundaryPressure)."""
+        return list(self._x_pos)
+
+    @boundaryXPos.setter
+    def boundaryXPos(self, value: Sequence[float]) -> None:
+        self._x_pos = tuple(attributes.as_numbers("boundaryXPos", value))
+        self._push_profile()
+
+    @property
+    def boundaryPressure(self) -> list[float]:
+        """Pressures along x on the ymax boundary, at boundaryXPos: while both lists have the same length
+        (at least 2) the Dirichlet cells of ymax (bndCondIsPressure[ymax]) take the pressure interpolated
+        at the x of their power centre, bndCondValue[ymax] beyond the points. Applies at the next step."""
+        return list(self._pressures)
+
+    @boundaryPressure.setter
+    def boundaryPressure(self, value: Sequence[float]) -> None:
+        self._pressures = tuple(attributes.as_numbers("boundaryPressure", value))
+        self._push_profile()
+
+    def _push_profile(self) -> None:
+        xs, ps = list(self._x_pos), list(self._pressures)
+        consistent = len(xs) == len(ps) and len(xs) >= 2
+        self._core.pressure_profile = (_YADE_WAVE_WALL, 0, xs, ps) if consistent else (_YADE_WAVE_WALL, 0, [], [])
 
     # -- the general form ---------------------------------------------------------------------------
     def set_boundary_pressure(self, wall: int, pressure: Callable[..., Any]) -> None:
@@ -110,12 +136,11 @@ class BoundaryPressure:
     @property
     def boundary_pressure(self) -> tuple[int, Callable[..., Any]] | None:
         """(wall, p) of set_boundary_pressure, or None."""
-        function = self._pressure_function
+        function = self._function
         return None if function is None or self._wave_action else function
 
-    @exclusive
     def _install(self, function: tuple[int, Callable[..., Any]] | None) -> None:
-        object.__setattr__(self, "_pressure_function", function)
+        self._function = function
         if function is None:
             self._core.set_pressure_field(-1, None)
         else:
@@ -123,22 +148,27 @@ class BoundaryPressure:
             method = weakref.WeakMethod(self._evaluate_pressure)
             self._core.set_pressure_field(function[0], lambda positions: method()(positions))
 
-    def _prepare_pressure(self, scene: Any, walls: Any) -> None:
+    @property
+    def active(self) -> bool:
+        """Whether a function load is set (waveAction or set_boundary_pressure)."""
+        return self._function is not None
+
+    def prepare(self, scene: Any, walls: Any) -> None:
         """Before a step with a load: the time and boundaries it is evaluated at."""
-        wall = self._pressure_function[0]
+        wall = self._function[0]
         if not self._core.bnd_is_pressure[wall]:
             name = "waveAction" if self._wave_action else "set_boundary_pressure"
             raise ValueError(f"{name}: wall {wall} ({WALL_NAMES[wall]}) is not a pressure boundary; set "
                              f"bndCondIsPressure[{wall}] = True")
-        object.__setattr__(self, "_field_time", float(scene.time))
-        object.__setattr__(self, "_field_walls", tuple(walls))
+        self._time = float(scene.time)
+        self._walls = tuple(walls)
 
     def _evaluate_pressure(self, positions: np.ndarray) -> np.ndarray:
         """Called by the core inside its step: the load at the wall's Dirichlet cells, checked."""
-        wall, function = self._pressure_function
+        wall, function = self._function
         name = "waveAction" if self._wave_action else f"set_boundary_pressure({WALL_NAMES[wall]})"
         n = len(positions)
-        p = function(positions[:, 0], positions[:, 1], positions[:, 2], self._field_time)
+        p = function(positions[:, 0], positions[:, 1], positions[:, 2], self._time)
         try:
             if p is None:  # numpy would take it for NaN
                 raise TypeError
@@ -154,5 +184,19 @@ class BoundaryPressure:
         if bad.any():
             i = int(np.argmax(bad))
             raise ValueError(f"{name}: the pressure function gave {p[i]} (not finite) at {tuple(positions[i])}, "
-                             f"t = {self._field_time} ({int(bad.sum())} of {n} cells)")
+                             f"t = {self._time} ({int(bad.sum())} of {n} cells)")
         return np.ascontiguousarray(p)
+
+    # -- O.save / O.load ----------------------------------------------------------------------------
+    def saved(self) -> dict[str, Any]:
+        """The settings (a function of set_boundary_pressure is not saved: the engine warns)."""
+        return {"wave_action": self._wave_action, "sine_magnitude": self._sine_magnitude,
+                "sine_average": self._sine_average, "boundary_x_pos": list(self._x_pos),
+                "boundary_pressure": list(self._pressures)}
+
+    def restore(self, state: dict[str, Any]) -> None:
+        self.sineMagnitude = state["sine_magnitude"]
+        self.sineAverage = state["sine_average"]
+        self.waveAction = state["wave_action"]
+        self._x_pos = tuple(state["boundary_x_pos"])
+        self._pressures = tuple(state["boundary_pressure"])

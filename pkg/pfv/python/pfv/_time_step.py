@@ -135,5 +135,5 @@ class TimeStepGuard:
             raise ValueError(message)
         if not self._unsafe:  # warn on becoming unsafe, not at every step while it stays so
             self._unsafe = True
-            # stacklevel 3: the engine's step, the caller of FlowEngine._check_time_step.
+            # stacklevel 3: the engine's step, the caller of TimeStepLimits.check.
             warnings.warn(message, TimeStepWarning, stacklevel=3)

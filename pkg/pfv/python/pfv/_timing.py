@@ -70,3 +70,13 @@ class StepClock:
                 parts += step[key]
         self._timings.add("core: rest of the step", max(step["total"] - parts, 0.0))
         self._last = time.perf_counter()
+
+
+class IdleClock:
+    """The step's clock while O.timingEnabled is off: records nothing."""
+
+    def lap(self, label: str) -> None:
+        pass
+
+    def core_step(self, core: Any, remeshed: bool) -> None:
+        pass

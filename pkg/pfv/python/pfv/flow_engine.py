@@ -9,21 +9,19 @@ An attribute YADE's FlowEngine has but PFV does not support may only be set to Y
 default value; any other value raises NotImplementedError naming it. Misspelt names raise
 AttributeError. Nothing is silently ignored.
 
-This module holds the engine class, which composes five parts: the attribute surface
-(``_attributes``), the scan of YADE's bodies (``_scene_scan.SceneScan``), the time-step
-guard (``_time_step.TimeStepGuard``), the members on single cells (``_cell_interface``, a mixin)
-and the time-dependent boundary pressures (``_boundary_pressure``, a mixin; ``pfv.waves``).
+The engine composes parts, each owning its state, and forwards YADE's names to them
+(``_forwarding``): the coupled bodies (``_coupled_bodies``), the run history
+(``_run_history``), the time-step limits (``_time_step_limits``), the boundary pressures
+(``_boundary_pressure``), the step's options, reports and warnings (``_step_options``,
+``_step_reports``, ``_step_warnings``), the settings kept for YADE's scripts
+(``_kept_settings``), the cells (``_cell_geometry``, ``_flow_queries``, ``_cell_conditions``)
+and the file outputs (``_file_outputs``). The attribute surface's rules are in ``_attributes``.
 """
 from __future__ import annotations
 
-import contextlib
 import numbers
-import os
-import re
 import threading
-import uuid
 import warnings
-import weakref
 from collections.abc import Sequence
 from typing import Any
 
@@ -31,34 +29,37 @@ import numpy as np
 
 import yade
 from yade.wrapper import NewtonIntegrator, PyRunner
-from yade.minieigenHP import Vector3
 
 from . import _attributes as attributes
 from . import _persistence
-from ._boundary_pressure import FIELD_INTERNAL, BoundaryPressure
-from ._locking import exclusive as _exclusive
-from ._cell_interface import CELL_CACHES, CELL_INTERNAL, CellInterface
+from . import _registry as registry
+from ._boundary_pressure import BoundaryPressure
+from ._cell_conditions import CellConditions
+from ._cell_geometry import CellGeometry
 from ._core import Engine, set_num_threads
+from ._coupled_bodies import CoupledBodies
+from ._file_outputs import FileOutputs
+from ._flow_queries import FlowQueries
+from ._forwarding import exclusive, method, setting
+from ._kept_settings import KeptSettings
+from ._run_history import RunHistory
 from ._scene_scan import SceneScan
-from ._timing import StageTimings, StepClock
-from ._time_step import TimeStepGuard, TimeStepWarning, viscous_time_step
+from ._step_options import StepOptions
+from ._step_reports import StepReports
+from ._step_warnings import StepWarnings, StepWatch
+from ._time_step import TimeStepWarning
+from ._time_step_limits import TimeStepLimits
+from ._timing import IdleClock, StageTimings, StepClock
 
 __all__ = ["FlowEngine", "TimeStepWarning"]
 
-_engines = weakref.WeakValueDictionary()  # PyRunner commands find their engine here
-# Keys of the engines that hold a mesh. YADE keeps a reference to every engine ever put into
-# O.engines, so an engine taken out is never freed: the step of an engine in use frees the mesh
-# of those no longer in their scene (_release_unused).
-_holding: set[int] = set()
 _MAX_THREADS = 1024  # ompThreads beyond this is a typo, not a machine
-_SCENE_TAG = "pfv.FlowEngine"  # key in O.tags of the token that tells this scene from a new one
-
-
-_COMMAND = "__import__('pfv.flow_engine').flow_engine._run({})"
+_COMMAND = "__import__('pfv.flow_engine').flow_engine._run({})"  # in saved scenes: keep the name _run
+_IDLE_CLOCK = IdleClock()
 
 
 def _run(key: int) -> None:
-    engine = _engines.get(key)
+    engine = registry.get(key)
     # After a load the running PyRunner is a restored copy, not this engine (which may still be
     # alive in this process): driving the old object would be silently wrong. A scene loaded
     # by O.load is adopted at the load; one loaded otherwise (yade file.yade.gz) is adopted here.
@@ -72,11 +73,6 @@ def _run(key: int) -> None:
     engine._step()
 
 
-def _as_tuples(value: Any) -> Any:
-    """JSON gives lists where the engine keeps tuples."""
-    return tuple(_as_tuples(v) for v in value) if isinstance(value, list) else value
-
-
 def _gravity(scene: Any) -> tuple[float, float, float]:
     """The gravity of the scene's NewtonIntegrator (zero without one)."""
     for engine in scene.engines:
@@ -85,77 +81,47 @@ def _gravity(scene: Any) -> tuple[float, float, float]:
     return (0.0, 0.0, 0.0)
 
 
-def _release_unused(current: FlowEngine) -> None:
-    """Free the meshes of the engines that ran in the current scene but are no longer in O.engines."""
-    others = [key for key in _holding if key != current._key]
-    if not others:
-        return
-    engines = yade.O.engines
-    for key in others:
-        engine = _engines.get(key)
-        if engine is None:
-            _holding.discard(key)
-        elif engine._in_scene(yade.O) and not any(e is engine for e in engines):
-            engine._release()
-
-
 # The core's settings saved with a scene: every one a user may set (YADE's names map onto most).
 # The upper clamp first: restoring must never meet a lower bound above the default upper one.
 _SAVED_CORE_SETTINGS = ("max_k_div_k_mean",) + tuple(sorted(
     (set(attributes.CORE_NAME.values()) | {"solver", "ordering", "max_iterations", "reuse_ordering",
                                            "cholmod_openmp_teams"}) - {"max_k_div_k_mean"}))
-_SAVED_GUARD_SETTINGS = ("safety", "strict", "iterations", "iterations_warm")
+
+# The engine's own fields (plain instance attributes, not YADE attributes): the core, the engine's
+# key in the registry, its lock, its timings, ompThreads, and its parts.
+_FIELDS = frozenset({"_core", "_key", "_lock", "_timings", "_threads", "_warnings", "_history", "_bodies",
+                     "_time_step", "_loads", "_options", "_reports", "_kept", "_geometry", "_flow",
+                     "_conditions", "_outputs"})
+# The parts saved with a scene, under these keys.
+_SAVED_PARTS = {"bodies": "_bodies", "loads": "_loads", "options": "_options", "reports": "_reports",
+                "kept": "_kept", "cells": "_geometry", "guard": "_time_step"}
 
 
-# Python-side state of a FlowEngine (not YADE attributes), set as plain instance attributes.
-_INTERNAL = frozenset({
-    "_core",                  # the C++ engine
-    "_key",                   # its key in _engines
-    "_lock",                  # held by a step and by every query (O.run steps on YADE's own thread)
-    "_scan",                  # the last SceneScan, None before the first step
-    "_stepped",               # the SceneScan of the last successful step: the current mesh's spheres
-    "_scene_tag",             # the value this engine left in O.tags: a new scene lacks it
-    "_last_step",             # (O.iter, O.time, dt) of the last successful step, None: no history
-    "_guard",                 # the TimeStepGuard
-    "_timings",               # the StageTimings shown by timing.stats()
-    "_boundary_use_max_min",  # boundaryUseMaxMin
-    "_wall_ids",              # wallIds
-    "_warned",                # the one-time warnings given
-    "_choice_builds",         # core.system_builds when the solver choice was last looked at
-    "_threads",               # ompThreads, None: follow YADE's -j
-    "_use_sphere_pack",       # False: always read the coordinate lists
-}) | CELL_INTERNAL | FIELD_INTERNAL
-
-
-def _guard_setting(name: str, doc: str) -> property:
-    """A FlowEngine property that reads and writes the TimeStepGuard's attribute `name`."""
-    return property(lambda self: getattr(self._guard, name), lambda self, value: setattr(self._guard, name, value),
-                    doc=doc)
-
-
-class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
+class FlowEngine(PyRunner):
     """PFV's DEM-PFV flow engine with the interface of YADE's FlowEngine."""
 
     xmin, xmax, ymin, ymax, zmin, zmax = range(6)
 
     def __init__(self, **kwargs: Any) -> None:
         PyRunner.__init__(self)
-        self._core = Engine()
+        self._core = core = Engine()
         self._key = id(self)
-        self._lock = threading.RLock()
+        self._lock = threading.RLock()  # held by a step and by every query (O.run steps on its own thread)
         self._timings = StageTimings()
-        self._stepped = None
-        self._scene_tag = None
-        self._last_step = None
-        self._boundary_use_max_min = [True] * 6
-        self._wall_ids = list(range(6))
-        self._warned = set()
-        self._choice_builds = 0
-        self._scan = None
-        self._use_sphere_pack = True
-        self._threads = None
-        self._guard = TimeStepGuard()
-        _engines[self._key] = self
+        self._threads = None  # ompThreads, None: follow YADE's -j
+        self._warnings = StepWarnings()
+        self._history = RunHistory(self._key)
+        self._bodies = CoupledBodies(core, self._warnings.given)
+        self._time_step = TimeStepLimits(core, self._bodies)
+        self._loads = BoundaryPressure(core)
+        self._options = StepOptions(core)
+        self._reports = StepReports(core)
+        self._kept = KeptSettings()
+        self._geometry = CellGeometry(core, self._bodies, self._history)
+        self._flow = FlowQueries(core, self._bodies, self._geometry)
+        self._conditions = CellConditions(core, self._geometry, self._flow)
+        self._outputs = FileOutputs(core, self._bodies, self._lock)
+        registry.add(self)
         self.command = _COMMAND.format(self._key)
         self.iterPeriod = 1
         self.initRun = True
@@ -172,7 +138,7 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
                     setattr(self._core, core_name, value)
                 except ValueError as error:
                     raise ValueError(f"pfv.FlowEngine.{name}: {error}") from None
-        elif name in _INTERNAL or name in _OWN_ATTRIBUTES:
+        elif name in _FIELDS or name in _OWN_ATTRIBUTES:
             object.__setattr__(self, name, value)
         elif attributes.is_yade_attribute(name):
             attributes.check_default(name, value)
@@ -188,6 +154,7 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
             return attributes.default(name)
         raise attributes.unknown_attribute(name, setting=False)
 
+    # -- the core's boundary conditions and solver, and the engine's threads --------------------
     @property
     def bndCondIsPressure(self) -> list[bool]:
         return list(self._core.bnd_is_pressure)
@@ -203,31 +170,6 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
     @bndCondValue.setter
     def bndCondValue(self, value: Sequence[float]) -> None:
         self._core.bnd_value = attributes.as_float6("bndCondValue", value)
-
-    @property
-    def boundaryUseMaxMin(self) -> list[bool]:
-        return list(self._boundary_use_max_min)
-
-    @boundaryUseMaxMin.setter
-    def boundaryUseMaxMin(self, value: Sequence[bool]) -> None:
-        value = attributes.as_bool6("boundaryUseMaxMin", value)
-        if value != self._boundary_use_max_min:
-            self._boundary_use_max_min = value
-            self._core.request_remesh()
-            self._core.reset_history()
-
-    @property
-    def wallIds(self) -> list[int]:
-        return list(self._wall_ids)
-
-    @wallIds.setter
-    def wallIds(self, value: Sequence[int]) -> None:
-        value = attributes.as_wall_ids(value)
-        if value != self._wall_ids:
-            self._wall_ids = value
-            if self._scan is not None:
-                self._scan.outdated = True
-            self._core.reset_history()
 
     @property
     def useSolver(self) -> int:
@@ -261,392 +203,215 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
             raise ValueError(f"ompThreads = {value} is more than {_MAX_THREADS} threads")
         self._threads = int(value) if value > 0 else None
 
-    # -- time-step guard settings (held by the TimeStepGuard) --------------------------------
-    time_step_safety = _guard_setting(
-        "safety", "O.dt must stay below time_step_safety * critical_time_step (zeta of thesis 4.22); 0.8.")
-    strict_time_step = _guard_setting(
-        "strict", "True: an unsafe O.dt raises ValueError instead of warning (TimeStepWarning).")
-    collective_iterations = _guard_setting(
-        "iterations", "Operator applications at most for the collective limit of the first mesh (cold start); 40.")
-    collective_iterations_warm = _guard_setting(
-        "iterations_warm", "Operator applications at most for the collective limit of a later mesh (warm start); 10.")
+    # -- the coupled bodies (_coupled_bodies) -----------------------------------------------
+    boundaryUseMaxMin = setting("_bodies", CoupledBodies.boundaryUseMaxMin)
+    wallIds = setting("_bodies", CoupledBodies.wallIds)
+    convertClumps = setting("_bodies", CoupledBodies.convertClumps)
+    mask = setting("_bodies", CoupledBodies.mask)
+    wallThickness = setting("_bodies", CoupledBodies.wallThickness)
+    idOffset = setting("_bodies", CoupledBodies.idOffset)
+    position_source = setting("_bodies", CoupledBodies.position_source)
+    setBoundaryNormal = method("_bodies", CoupledBodies.setBoundaryNormal)
+
+    # -- the time-step limits (_time_step_limits) ---------------------------------------------
+    time_step_safety = setting("_time_step", TimeStepLimits.time_step_safety)
+    strict_time_step = setting("_time_step", TimeStepLimits.strict_time_step)
+    collective_iterations = setting("_time_step", TimeStepLimits.collective_iterations)
+    collective_iterations_warm = setting("_time_step", TimeStepLimits.collective_iterations_warm)
+    viscous_time_step = setting("_time_step", TimeStepLimits.viscous_time_step)
+    collective_viscous_time_step = setting("_time_step", TimeStepLimits.collective_viscous_time_step)
+    collective_viscous_bound = setting("_time_step", TimeStepLimits.collective_viscous_bound)
+    collective_viscous_history = setting("_time_step", TimeStepLimits.collective_viscous_history)
+    critical_time_step = setting("_time_step", TimeStepLimits.critical_time_step)
+
+    # -- boundary pressures beyond bndCondValue (_boundary_pressure) ----------------------------
+    waveAction = setting("_loads", BoundaryPressure.waveAction)
+    sineMagnitude = setting("_loads", BoundaryPressure.sineMagnitude)
+    sineAverage = setting("_loads", BoundaryPressure.sineAverage)
+    boundaryXPos = setting("_loads", BoundaryPressure.boundaryXPos)
+    boundaryPressure = setting("_loads", BoundaryPressure.boundaryPressure)
+    boundary_pressure = setting("_loads", BoundaryPressure.boundary_pressure)
+    set_boundary_pressure = method("_loads", BoundaryPressure.set_boundary_pressure)
+    clear_boundary_pressure = method("_loads", BoundaryPressure.clear_boundary_pressure)
+
+    # -- what a step does and reports (_step_options, _step_reports) ----------------------------
+    pressureForce = setting("_options", StepOptions.pressureForce)
+    decoupleForces = setting("_options", StepOptions.decoupleForces)
+    desiredPorosity = setting("_options", StepOptions.desiredPorosity)
+    blockHook = setting("_reports", StepReports.blockHook)
+    debug = setting("_reports", StepReports.debug)
+    getCHOLMODPerfTimings = setting("_reports", StepReports.getCHOLMODPerfTimings)
+    meanKStat = setting("_reports", StepReports.meanKStat)
+
+    # -- kept for YADE's scripts, no effect (_kept_settings) --------------------------------------
+    permeabilityMap = setting("_kept", KeptSettings.permeabilityMap)
+    numSolveThreads = setting("_kept", KeptSettings.numSolveThreads)
+    numFactorizeThreads = setting("_kept", KeptSettings.numFactorizeThreads)
+    boundaryVelocity = setting("_kept", KeptSettings.boundaryVelocity)
+    ids = setting("_kept", KeptSettings.ids)
+    volumeFactor = setting("_kept", KeptSettings.volumeFactor)
+
+    # -- the mesh: cells, throats, volumes (_cell_geometry) ---------------------------------------
+    iniVoidVolumes = setting("_geometry", CellGeometry.iniVoidVolumes)
+    porosity = setting("_geometry", CellGeometry.porosity)
+    epsVolMax = setting("_geometry", CellGeometry.epsVolMax)
+    nCells = method("_geometry", CellGeometry.nCells)
+    getCell = method("_geometry", CellGeometry.getCell)
+    getCellCenter = method("_geometry", CellGeometry.getCellCenter)
+    getCellVolume = method("_geometry", CellGeometry.getCellVolume)
+    getCellBarycenter = method("_geometry", CellGeometry.getCellBarycenter)
+    getVertices = method("_geometry", CellGeometry.getVertices)
+    getNeighbors = method("_geometry", CellGeometry.getNeighbors)
+    isCellNeighbor = method("_geometry", CellGeometry.isCellNeighbor)
+    getIncidentCells = method("_geometry", CellGeometry.getIncidentCells)
+    getConductivity = method("_geometry", CellGeometry.getConductivity)
+    getDiffusionCoeff = method("_geometry", CellGeometry.getDiffusionCoeff)
+    surfaceSolidThroatInPore = method("_geometry", CellGeometry.surfaceSolidThroatInPore)
+    getConstrictions = method("_geometry", CellGeometry.getConstrictions)
+    getConstrictionsFull = method("_geometry", CellGeometry.getConstrictionsFull)
+    getCellInvVoidVolume = method("_geometry", CellGeometry.getCellInvVoidVolume)
+    initializeVolumes = method("_geometry", CellGeometry.initializeVolumes)
+    updateVolumes = method("_geometry", CellGeometry.updateVolumes)
+    compTessVolumes = method("_geometry", CellGeometry.compTessVolumes)
+    volume = method("_geometry", CellGeometry.volume)
+
+    # -- the flow: pressures, fluxes, velocities, forces (_flow_queries) ----------------------------
+    getPorePressure = method("_flow", FlowQueries.getPorePressure)
+    getCellPressure = method("_flow", FlowQueries.getCellPressure)
+    averagePressure = method("_flow", FlowQueries.averagePressure)
+    averageSlicePressure = method("_flow", FlowQueries.averageSlicePressure)
+    absolute_pressure = method("_flow", FlowQueries.absolute_pressure)
+    getCellFluxFromId = method("_flow", FlowQueries.getCellFluxFromId)
+    getCellFlux = method("_flow", FlowQueries.getCellFlux)
+    getBoundaryFlux = method("_flow", FlowQueries.getBoundaryFlux)
+    getBoundaryFluidArea = method("_flow", FlowQueries.getBoundaryFluidArea)
+    getBoundaryVel = method("_flow", FlowQueries.getBoundaryVel)
+    getBoundaryVolume = method("_flow", FlowQueries.getBoundaryVolume)
+    getCellVelocity = method("_flow", FlowQueries.getCellVelocity)
+    averageVelocity = method("_flow", FlowQueries.averageVelocity)
+    avFlVelOnSph = method("_flow", FlowQueries.avFlVelOnSph)
+    fluidForce = method("_flow", FlowQueries.fluidForce)
+    shearLubForce = method("_flow", FlowQueries.shearLubForce)
+    metisUsed = method("_flow", FlowQueries.metisUsed)
+
+    # -- conditions on points and cells (_cell_conditions) ------------------------------------------
+    updateBCs = method("_conditions", CellConditions.updateBCs)
+    imposePressure = method("_conditions", CellConditions.imposePressure)
+    setImposedPressure = method("_conditions", CellConditions.setImposedPressure)
+    clearImposedPressure = method("_conditions", CellConditions.clearImposedPressure)
+    imposeFlux = method("_conditions", CellConditions.imposeFlux)
+    clearImposedFlux = method("_conditions", CellConditions.clearImposedFlux)
+    getCellPImposed = method("_conditions", CellConditions.getCellPImposed)
+    setCellPImposed = method("_conditions", CellConditions.setCellPImposed)
+    setCellPressure = method("_conditions", CellConditions.setCellPressure)
+    blockCell = method("_conditions", CellConditions.blockCell)
+    imposePressureFromId = method("_conditions", CellConditions.imposePressureFromId)
+    resetLinearSystem = method("_conditions", CellConditions.resetLinearSystem)
+
+    # -- file outputs (_file_outputs) -----------------------------------------------------------------
+    pressureProfile = method("_outputs", FileOutputs.pressureProfile)
+    printVertices = method("_outputs", FileOutputs.printVertices)
+    exportTriplets = method("_outputs", FileOutputs.exportTriplets)
+    exportMatrix = method("_outputs", FileOutputs.exportMatrix)
+    cholmodStats = method("_outputs", FileOutputs.cholmodStats)
+    saveVtk = method("_outputs", FileOutputs.saveVtk, locked=False)  # locks while it reads, not while it writes
 
     # -- the step ---------------------------------------------------------------------------
-    def _rescan(self) -> SceneScan:
-        """Scan the bodies again (sphere ids, radii, masses, walls); done at each remesh (bodies may change)."""
-        self._apply_id_offset()
-        self._scan = SceneScan(self._wall_ids, self._boundary_use_max_min, use_sphere_pack=self._use_sphere_pack,
-                               warned=self._warned, previous=self._scan, **self._scan_options())
-        return self._scan
-
-    def _scanned(self) -> SceneScan:
-        """The current scan; scans first if there is none or wallIds changed since."""
-        if self._scan is None or self._scan.outdated:
-            return self._rescan()
-        return self._scan
-
-    @property
-    def position_source(self) -> str:
-        """Where the sphere centres come from each step: "SpherePack" (YADE's C++ copy of the
-        bodies' centres, read in place) or "coordinate lists" (yade._utils.coordsAndDisplacements,
-        one Python list per axis; used when the pack's layout does not check out)."""
-        return "coordinate lists" if self._scan is None else self._scan.position_source
-
-    def _read_positions(self) -> tuple[np.ndarray, list[float]] | None:
-        """Sphere centres (n, 3) and the six boundary coordinates, or None if bodies were erased
-        since the last scan."""
-        return self._scan.read_positions(self._boundary_use_max_min)
-
-    def _in_scene(self, scene: Any) -> bool:
-        """Whether this engine last ran in `scene` (which then holds its tag)."""
-        try:
-            return self._scene_tag is not None and scene.tags[f"{_SCENE_TAG}.{self._key}"] == self._scene_tag
-        except KeyError:
-            return False
-
-    @_exclusive
-    def _release(self) -> None:
-        """Free the mesh and the scan (settings kept): the next step starts afresh."""
-        self._core.release()
-        self._scan = self._stepped = None
-        self._last_step = None
-        _holding.discard(self._key)
-
-    def _notice_new_scene(self, scene: Any) -> None:
-        """After O.reset() (or O.switchScene) the engine may be put into a scene it has never
-        seen, possibly with as many bodies as the last one: forget everything of the old one."""
-        if self._in_scene(scene):
-            return
-        if self._scene_tag is not None:  # not the first step: a new scene
-            # The collective limit follows with the new mesh (its history and the mode that warm
-            # starts it carry over: the mode is only a starting vector).
-            self._scan = self._stepped = None
-            self._core.request_remesh()
-            self._core.reset_history()
-            self._last_step = None
-        self._scene_tag = uuid.uuid4().hex
-        scene.tags[f"{_SCENE_TAG}.{self._key}"] = self._scene_tag
-
-    def _time_since_last_step(self, scene: Any) -> float:
-        """The time the positions moved over since the last step of this engine, or O.dt with the
-        history forgotten when that step was not the last iteration's run of the engine (it was
-        dead, its iterPeriod skipped, or the last step failed): dV/dt must not span a gap."""
-        last = self._last_step
-        period = max(1, int(self.iterPeriod))
-        if last is not None and scene.iter - last[0] == period:
-            return scene.dt if period == 1 else scene.time - last[1]
-        if last is not None:
-            self._core.reset_history()
-        return scene.dt
-
-    @_exclusive
+    @exclusive
     def _step(self) -> None:
-        if not self._pressure_force:  # YADE's pressureForce=False: no flow at all
+        if not self._options.pressureForce:  # YADE's pressureForce=False: no flow at all
             return
         scene = yade.O
-        core = self._core
-        clock = StepClock(self._timings) if scene.timingEnabled else None
-        self._notice_new_scene(scene)
-        scan = self._scan
-        bodies_changed = scan is None or scan.outdated or len(scene.bodies) != scan.n_bodies
-        if bodies_changed or core.remesh_due():
-            self._rescan()  # radii and masses may have changed too
-            if bodies_changed:
-                core.request_remesh()
-        read = self._read_positions()
-        if read is None:  # bodies erased (which leaves len(O.bodies) as it was)
-            self._rescan()
-            core.request_remesh()
-            read = self._read_positions()
-        scan = self._scan
-        pos, walls = read
+        clock = StepClock(self._timings) if scene.timingEnabled else _IDLE_CLOCK
+        self._enter_scene(scene)
+        scan, pos, walls = self._bodies.for_step(scene)
         set_num_threads(self._threads or scene.numThreads)
-        if clock:
-            clock.lap("scan and positions")
-        dt = self._time_since_last_step(scene)
-        if core.fluid_density > 0:  # buoyancy under the NewtonIntegrator's gravity
-            core.gravity = _gravity(scene)
+        clock.lap("scan and positions")
+        dt = self._before_step(scene, scan)
+        watch, reports = StepWatch(self._core), self._reports.before_step()
+        self._options.correct_volumes(pos, scan.radii)
+        clock.lap("time-step guard")
+        self._advance(scene, scan, pos, walls, dt, watch.remeshing)
+        clock.core_step(self._core, watch.remeshed(self._core))
+        self._record(scene, scan, dt)
+        self._time_step.check_new_mesh(scene.dt, scan)
+        self._warnings.after_step(self._core, scene.iter, scan, watch)
+        clock.lap("time-step guard and warnings")
+        self._reports.after_step(reports)
+        self._apply_forces(scene, scan)
+        clock.lap("forces to YADE")
+
+    def _enter_scene(self, scene: Any) -> None:
+        """After O.reset() (or O.switchScene) the engine may be put into a scene it has never
+        seen, possibly with as many bodies as the last one: forget everything of the old one.
+        The collective limit follows with the new mesh (its history and the mode that warm
+        starts it carry over: the mode is only a starting vector)."""
+        if self._history.enter(scene):
+            self._bodies.forget()
+            self._core.request_remesh()
+            self._core.reset_history()
+
+    def _before_step(self, scene: Any, scan: SceneScan) -> float:
+        """The time this step's dV/dt spans (the history forgotten after a gap), the gravity of the
+        buoyancy, and the time-step check on the limits known before the step; returns the time."""
+        dt, forget = self._history.time_since_last_step(scene, self.iterPeriod)
+        if forget:
+            self._core.reset_history()
+        if self._core.fluid_density > 0:  # buoyancy under the NewtonIntegrator's gravity
+            self._core.gravity = _gravity(scene)
         # Before the step, only limits known for the mesh the step will use (a mesh about to be
         # rebuilt, or conductances about to change, have no limit yet: checked after the step).
-        self._check_time_step(scene.dt, scan, before_step=True)
-        remeshing = core.remesh_due()
-        inversions, meshes = core.inversion_remeshes, core.remesh_count
-        before = (core.remesh_count, core.system_builds) if self._after_step_reports else None
-        if self._desired_porosity:
-            self._correct_volumes(pos, scan.radii)
-        if clock:
-            clock.lap("time-step guard")
-        if self._pressure_function is not None:
-            self._prepare_pressure(scene, walls)
-        with self._bodies_named(scan):
-            if self._block_hook and remeshing and not core.background_remesh:
-                self._remesh_for_block_hook(pos, scan, walls)  # blockHook, between the mesh and its system
+        self._time_step.check(scene.dt, scan, before_step=True)
+        return dt
+
+    def _advance(self, scene: Any, scan: SceneScan, pos: np.ndarray, walls: list[float], dt: float,
+                 remeshing: bool) -> None:
+        """The core's step: remesh when due, dV/dt, solve, forces; with a load evaluated at this step's
+        time, and blockHook between a new mesh and its linear system."""
+        core = self._core
+        if self._loads.active:
+            self._loads.prepare(scene, walls)
+        with self._bodies.named_in_errors(scan):
+            if self._reports.hooks_remesh(remeshing):
+                core.remesh(pos, scan.radii, walls)  # without a linear system: blockHook sets conditions first
+                self._bodies.stepped = scan
+                self._reports.run_block_hook()
             core.step(pos, scan.radii, walls, dt)
-        if clock:
-            clock.core_step(core, core.remesh_count != meshes)
-        self._stepped = scan
-        self._last_step = (scene.iter, scene.time, dt)  # dt: the time this step's dV/dt spanned
-        _holding.add(self._key)
-        _release_unused(self)
-        if self._guard.unchecked(core):
-            # A new mesh (the first, or a remesh adopted by this step) or new conductances: its
-            # collective limit may be lower (a compacting sample), check again.
-            self._check_time_step(scene.dt, scan)
-        if not core.converged and "unconverged" not in self._warned:
-            self._warned.add("unconverged")
-            warnings.warn(f"pfv.FlowEngine: at iteration {scene.iter} the {core.solver.replace('_', ' ')} solve "
-                          f"stopped at {core.max_iterations} iterations above tolerance = {core.tolerance:g}; "
-                          "the pressures are not converged (raise the tolerance or use useSolver=3)", stacklevel=2)
-        if core.inversion_remeshes != inversions and "inverted" not in self._warned:
-            self._warned.add("inverted")
-            warnings.warn(f"pfv.FlowEngine: at iteration {scene.iter} spheres had moved so far since the last "
-                          "remesh that pore cells were turned inside out; remeshed (and will again whenever "
-                          "this happens). Lower meshUpdateInterval or defTolerance for motion this fast",
-                          stacklevel=2)
-        # The choice changes only with a new system: look at it once per build, not per step.
-        if "auto multigrid" not in self._warned and core.system_builds != self._choice_builds:
-            self._choice_builds = core.system_builds
-            choice = core.solver_choice
-            if core.solver == "auto" and choice.startswith("multigrid: the Cholesky"):  # not "kept from ..."
-                self._warned.add("auto multigrid")
-                bound = ", or raise max_factor_bytes" if "budget" in choice else ""  # not CHOLMOD's index range
-                warnings.warn(f"pfv.FlowEngine: solver='auto' solves by multigrid from iteration {scene.iter}: "
-                              f"{choice[len('multigrid: '):]}. Set solver='multigrid' to skip the Cholesky "
-                              f"analysis at the start{bound}", stacklevel=2)
-        if remeshing or core.inversion_remeshes != inversions:
-            hidden = core.hidden_spheres()
-            if hidden:
-                yade_ids = scan.ids[hidden][:10].tolist()
-                warnings.warn(f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
-                              f"regular triangulation and get no fluid force (ids {yade_ids}...)",
-                              stacklevel=2)
-        if clock:
-            clock.lap("time-step guard and warnings")
-        if self._after_step_reports:
-            self._report_step(before)
-        # The engine's force array is read in C++, without a numpy copy.
-        if not self._decouple_forces:
-            scan.force_bridge.apply(scene.forces.addF, core)
-        if clock:
-            clock.lap("forces to YADE")
+
+    def _record(self, scene: Any, scan: SceneScan, dt: float) -> None:
+        """A step made: the mesh holds the spheres of `scan`; `dt` the time its dV/dt spanned."""
+        self._bodies.stepped = scan
+        self._history.record(scene, dt)
+        registry.hold(self)
+        registry.release_unused(self)
+
+    def _apply_forces(self, scene: Any, scan: SceneScan) -> None:
+        """The fluid forces to YADE's bodies, unless decoupleForces (read in C++, without a numpy copy)."""
+        if not self._options.decoupleForces:
+            scan.force_bridge.apply(scene.forces.addF, self._core)
+
+    def emulateAction(self) -> None:
+        """Run one flow step outside the time-stepping loop, as YADE's method does."""
+        self._step()
 
     @property
     def timingDeltas(self) -> StageTimings:
         """The engine's stages for YADE's timing.stats() while O.timingEnabled (_timing.py)."""
         return self._timings
 
-    @contextlib.contextmanager
-    def _bodies_named(self, scan: SceneScan):
-        """Errors of the core name spheres by their index in the scan and walls by number: say
-        which YADE body is meant, and which sphere set a wall placed by boundaryUseMaxMin."""
-        try:
-            yield
-        except (ValueError, RuntimeError) as error:
-            message = re.sub(r"sphere (\d+)", lambda m: f"sphere #{scan.ids[int(m.group(1))]}", str(error))
-            setters = [scan.describe_wall_setter(int(w)) for w in sorted(set(re.findall(r"walls? (\d)", message)))]
-            setters = [s for s in setters if s]
-            if setters:
-                message += " (" + "; ".join(setters) + ")"
-            raise type(error)(f"pfv.FlowEngine: {message}") from None
+    # -- the engine's mesh ----------------------------------------------------------------------
+    @exclusive
+    def _release(self) -> None:
+        """Free the mesh and the scan (settings kept): the next step starts afresh."""
+        self._core.release()
+        self._bodies.forget()
+        self._history.last_step = None
+        registry.drop(self)
 
-    @property
-    @_exclusive
-    def viscous_time_step(self) -> float:
-        """dt_MV = pi rho d^2 / (1200 mu) at the smallest rho d^2 of the coupled dynamic spheres (thesis 4.20)."""
-        return viscous_time_step(self._scanned().mass_per_diameter, self._core.viscosity)
-
-    @property
-    def collective_viscous_time_step(self) -> float:
-        """2 / lambda_max(M^-1 V) of the current mesh: the viscous limit of the explicit coupling
-        for collective motions (groups of spheres squeezing shared pores), which the thesis'
-        single-particle dt_MV overestimates (0.3-0.5 dt_MV measured on dense packings).
-        Computed when asked for, or by the time-step guard on a new mesh (or a new viscosity) when
-        the certified bound on it (collective_viscous_bound) cannot show O.dt safe: by Arnoldi from
-        a fixed start (at most collective_iterations = 40 operator applications, stopping once the
-        estimate settles to 1e-6 or its Arnoldi residual is below 1e-3 of it), or by power iteration
-        started from the mode of the mesh just before, if computed there (at most
-        collective_iterations_warm = 10). Each operator application
-        costs one back-substitution and one force evaluation; see collective_viscous_history
-        ("iterations" there is the count made, "max_iterations" the cap, "seconds" the cost)."""
-        with self._lock:
-            if not self._core.has_mesh() or self._stepped is None:
-                return float("inf")
-            # The masses of the spheres the mesh holds (even if bodies or wallIds changed since).
-            return self._guard.collective_limit(self._core, self._stepped.masses, yade.O.iter)
-
-    @property
-    def collective_viscous_bound(self) -> float:
-        """The best certified lower bound on collective_viscous_time_step without computing it: the
-        larger of the global bound (about one solve, up to four orders of magnitude below the limit;
-        what the time-step guard checks O.dt against first) and the local one (small problems around
-        each sphere, within an order of magnitude of the limit, several times the cost of the global
-        one). O.dt = time_step_safety * min(this, dt_MV, P-wave step) is safe. 0 with viscousShear,
-        which neither covers (doc/model.md, "Coupled time step")."""
-        with self._lock:
-            if not self._core.has_mesh() or self._stepped is None:
-                return float("inf")
-            masses = self._stepped.masses
-            return max(self._core.viscous_stability_bound(masses), self._core.viscous_stability_local_bound(masses))
-
-    @property
-    def collective_viscous_history(self) -> list[dict[str, Any]]:
-        """One dict per computation of the collective limit or its bound: iter, remesh_count, limit [s],
-        method ("bound": the certified lower bound; "arnoldi"; "power": from the previous mesh's mode),
-        iterations (operator applications made, each a solve and a force evaluation), max_iterations
-        (the cap), warm (method == "power"), seconds (wall time)."""
-        return self._guard.history
-
-    @property
-    def critical_time_step(self) -> float:
-        """min(dt_MV, collective viscous limit, DEM P-wave limit): O.dt should not exceed
-        time_step_safety times this."""
-        with self._lock:
-            scan = self._scanned()
-            return min(self.viscous_time_step, self.collective_viscous_time_step, scan.dt_dem)
-
-    def _check_time_step(self, dt: float, scan: SceneScan | None = None, before_step: bool = False) -> None:
-        """Warn or raise (strict_time_step) if dt exceeds time_step_safety * critical_time_step,
-        with the single-particle and DEM limits of `scan` (None: the current scan) and the collective
-        limit of the current mesh, or its certified bound where that suffices (_time_step.py).
-        `before_step`: the mesh may be about to change, nothing is computed for it then."""
-        if scan is None:
-            scan = self._scanned()
-        dt_mv = viscous_time_step(scan.mass_per_diameter, self._core.viscosity)
-        collective = float("inf")
-        if self._stepped is not None:  # the masses of the spheres the mesh holds
-            collective = self._guard.limit_to_check(self._core, self._stepped.masses, dt, min(dt_mv, scan.dt_dem),
-                                                    yade.O.iter, before_step)
-        self._guard.check(dt, dt_mv, collective, scan.dt_dem)
-
-    def emulateAction(self) -> None:
-        """Run one flow step outside the time-stepping loop, as YADE's method does."""
-        self._step()
-
-    # -- boundary conditions --------------------------------------------------------------
-    @_exclusive
-    def updateBCs(self) -> None:
-        """Apply changed boundary values and types (PFV applies values at every step anyway)."""
-        self._core.request_system_rebuild()
-
-    @_exclusive
-    def imposePressure(self, pos: Sequence[float], p: float) -> int:
-        """Impose pressure p in the cell containing pos; returns the condition's index. A point
-        outside the pore space is refused (at once once there is a mesh, else at the first step)."""
-        return self._core.impose_pressure(attributes.as_point("imposePressure position", pos),
-                                          attributes.as_number("imposePressure pressure", p))
-
-    @_exclusive
-    def setImposedPressure(self, cond: int, p: float) -> None:
-        """Change the pressure of the imposed condition number cond."""
-        self._core.set_imposed_pressure(int(cond), attributes.as_number("setImposedPressure pressure", p))
-
-    @_exclusive
-    def clearImposedPressure(self) -> None:
-        self._core.clear_imposed_pressure()
-
-    @_exclusive
-    def imposeFlux(self, pos: Sequence[float], p: float) -> None:
-        """YADE's sign: outflux positive, influx negative. A point outside the pore space is refused."""
-        self._core.impose_flux(attributes.as_point("imposeFlux position", pos),
-                               -attributes.as_number("imposeFlux flux", p))
-
-    @_exclusive
-    def clearImposedFlux(self) -> None:
-        self._core.clear_imposed_flux()
-
-    # -- queries: each waits for a step in progress on YADE's simulation thread -------------
-    def _require_mesh(self) -> None:
-        if not self._core.has_mesh() or self._stepped is None:
-            raise RuntimeError("the flow engine has not run yet: no pore mesh (run at least one step)")
-
-    def _cell_at(self, pos: Sequence[float]) -> int:
-        self._require_mesh()
-        cell = self._core.locate(attributes.as_point("position", pos))
-        if cell < 0:
-            raise ValueError(f"point {tuple(pos)} lies in no pore cell (outside the walls or the packing)")
-        return cell
-
-    def _vertex_of(self, body_id: int) -> int:
-        self._require_mesh()
-        v = self._stepped.vertex_of_id.get(int(body_id))
-        if v is None:
-            raise ValueError(f"body {body_id} is not coupled with the fluid (not a sphere nor a wall)")
-        return v
-
-    @_exclusive
-    def getPorePressure(self, pos: Sequence[float]) -> float:
-        return self._core.cell_pressure(self._cell_at(pos))
-
-    @_exclusive
-    def getCell(self, X: float, Y: float, Z: float) -> int:
-        self._require_mesh()
-        return self._core.locate(attributes.as_point("getCell position", (X, Y, Z)))
-
-    @_exclusive
-    def getCellPressure(self, id: int) -> float:
-        return self._core.cell_pressure(int(id))
-
-    @_exclusive
-    def getCellCenter(self, id: int) -> Vector3:
-        return Vector3(*self._core.cell_center(int(id)))
-
-    @_exclusive
-    def getCellVolume(self, pos: Sequence[float]) -> float:
-        return self._core.cell_volume(self._cell_at(pos))
-
-    @_exclusive
-    def getBoundaryFlux(self, boundary: int) -> float:
-        self._require_mesh()
-        wall_ids = self._stepped.wall_ids  # those of the last step, if wallIds changed since
-        if boundary not in wall_ids:
-            raise ValueError(f"body {boundary} is not one of the boundaries wallIds = {wall_ids}")
-        return self._core.boundary_flux(wall_ids.index(boundary))
-
-    @_exclusive
-    def fluidForce(self, idSph: int) -> Vector3:
-        return Vector3(*self._core.forces()[self._vertex_of(idSph)])
-
-    @_exclusive
-    def shearLubForce(self, idSph: int) -> Vector3:
-        """The viscous shear part of fluidForce(idSph) (viscousShear; zero while it is off).
-        YADE's name: its shearLubForce reports the viscousShear force as well."""
-        v = self._vertex_of(idSph)
-        shear = self._core.shear_forces()
-        return Vector3(*shear[v]) if len(shear) else Vector3(0, 0, 0)
-
-    @_exclusive
-    def nCells(self) -> int:
-        return self._core.n_cells()
-
-    @_exclusive
-    def averagePressure(self) -> float:
-        self._require_mesh()
-        return self._core.average_pressure()
-
-    @_exclusive
-    def averageSlicePressure(self, posY: float, axis: int = 1) -> float:
-        self._require_mesh()
-        return self._core.average_slice_pressure(int(axis), attributes.as_number("averageSlicePressure position", posY))
-
-    @_exclusive
-    def metisUsed(self) -> bool:
-        return self._core.metis_used()
-
-    @_exclusive
-    def absolute_pressure(self, pos: Sequence[float]) -> float:
-        """The pore pressure at pos with its hydrostatic part: getPorePressure(pos) + fluid_density g.(pos - top),
-        `top` the centre of the wall that faces up (against gravity's largest component). Equals the
-        excess pressure without buoyancy (fluid_density = 0)."""
-        p = self._core.cell_pressure(self._cell_at(pos))
-        rho = self._core.fluid_density
-        if rho == 0:
-            return p
-        g = np.array(self._core.gravity)
-        walls = self._core.walls()
-        top = np.array([(walls[0] + walls[1]) / 2, (walls[2] + walls[3]) / 2, (walls[4] + walls[5]) / 2])
-        axis = int(np.abs(g).argmax())
-        top[axis] = walls[2 * axis + 1] if g[axis] < 0 else walls[2 * axis]
-        return p + rho * float(g @ (np.asarray(attributes.as_point("position", pos)) - top))
+    def _release_if_gone(self, scene: Any, engines: Sequence[Any]) -> None:
+        """_release() if this engine ran in `scene` but is no longer among its `engines`."""
+        if self._history.in_scene(scene) and not any(e is self for e in engines):
+            self._release()
 
     # -- O.save / O.load (_persistence) -----------------------------------------------------
     @staticmethod
@@ -654,32 +419,26 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
         """Whether a PyRunner command is that of a pfv.FlowEngine (a restored one after a load)."""
         return command.startswith(_COMMAND.split("{")[0])
 
-    @_exclusive
+    @exclusive
     def _saved_state(self) -> dict[str, Any]:
         """Everything a new engine needs to go on where this one is: settings, boundary conditions,
-        the Python-side settings and, once it has run, the core's run state."""
+        the parts' settings and, once it has run, the core's run state."""
         core = self._core
-        running = core.has_mesh() and self._stepped is not None
-        if self.boundary_pressure is not None and "unsaved function" not in self._warned:
-            self._warned.add("unsaved function")
+        running = self._bodies.has_mesh()
+        if self._loads.boundary_pressure is not None and self._warnings.once("unsaved function"):
             warnings.warn("pfv.FlowEngine: the function of set_boundary_pressure is not saved with the scene; "
                           "set it again after O.load", stacklevel=3)
+        last_step = self._history.last_step
         return {
             "core": {name: getattr(core, name) for name in _SAVED_CORE_SETTINGS},
             "bnd_is_pressure": list(core.bnd_is_pressure),
             "bnd_value": list(core.bnd_value),
             "imposed_pressures": core.imposed_pressures(),
             "imposed_fluxes": core.imposed_fluxes(),
-            "boundary_use_max_min": list(self._boundary_use_max_min),
-            "wall_ids": list(self._wall_ids),
             "threads": self._threads,
-            "use_sphere_pack": self._use_sphere_pack,
-            "mixin": {name: getattr(self, name) for name in sorted(CELL_INTERNAL - CELL_CACHES)},
-            "waves": {"wave_action": self._wave_action, "sine_magnitude": self._sine_magnitude,
-                      "sine_average": self._sine_average},
-            "guard": {name: getattr(self._guard, name) for name in _SAVED_GUARD_SETTINGS},
+            **{key: getattr(self, part).saved() for key, part in _SAVED_PARTS.items()},
             "runner": {name: getattr(self, name) for name in ("iterPeriod", "dead", "initRun")},
-            "last_step": list(self._last_step) if running and self._last_step else None,
+            "last_step": list(last_step) if running and last_step else None,
             "run": core.run_state() if running else None,
         }
 
@@ -696,52 +455,24 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
             core.impose_pressure(tuple(pos), p)
         for pos, q in state["imposed_fluxes"]:
             core.impose_flux(tuple(pos), q)
-        engine._boundary_use_max_min = list(state["boundary_use_max_min"])
-        engine._wall_ids = list(state["wall_ids"])
         engine._threads = state["threads"]
-        engine._use_sphere_pack = state["use_sphere_pack"]
-        for name, value in state["mixin"].items():
-            setattr(engine, name, _as_tuples(value))
-        waves = state.get("waves", {})
-        engine.sineMagnitude = waves.get("sine_magnitude", 0.0)
-        engine.sineAverage = waves.get("sine_average", 0.0)
-        engine.waveAction = waves.get("wave_action", False)
-        for name, value in state["guard"].items():
-            setattr(engine._guard, name, value)
+        for key, part in _SAVED_PARTS.items():
+            getattr(engine, part).restore(state[key])
         for name, value in state["runner"].items():
             setattr(engine, name, value)
         engine.label = runner.label
         if state["run"] is not None:
-            scene = yade.O
-            engine._notice_new_scene(scene)
-            core.resume(state["run"], scene.dt)
-            engine._stepped = engine._rescan()
-            engine._last_step = tuple(state["last_step"])
-            _holding.add(engine._key)
+            engine._resume(state["run"], state["last_step"])
         return engine
 
-    # -- output ------------------------------------------------------------------------------
-    def saveVtk(self, folder: str | os.PathLike = "./VTK", withBoundaries: bool = False,
-                compress: bool = False) -> None:
-        """Write the pore network (pressure, mean fluid velocity, imposed-pressure flag, volumes) and the spheres
-        (radii, ids, fluid forces) of the last step into `folder` as VTK XML files for ParaView: out_<N>.vtu,
-        spheres_<N>.vtu and the collection out.pvd of every snapshot this process wrote there, at O.time.
-        withBoundaries=False leaves out the cells with a wall vertex (YADE's default); compress=True compresses
-        the data with zlib. See doc/yade.md, "VTK output"."""
-        if not isinstance(folder, (str, os.PathLike)):
-            raise TypeError(f"saveVtk folder must be a path, got {folder!r}")
-        with_boundaries = attributes.as_flag("saveVtk withBoundaries", withBoundaries)
-        compress = attributes.as_flag("saveVtk compress", compress)
-        try:
-            from . import _vtk_output
-        except ImportError as error:
-            raise ImportError(f"pfv.FlowEngine.saveVtk needs VTK's Python package (Debian: apt-get install "
-                              f"python3-vtk9): {error}") from None
-        with self._lock:
-            self._require_mesh()
-            scan = self._stepped
-            state = _vtk_output.read_state(self._core, scan.ids, scan.radii, scan.wall_ids, yade.O.time)
-        _vtk_output.save(state, os.fspath(folder), with_boundaries, compress)
+    def _resume(self, run: dict[str, Any], last_step: Sequence[Any]) -> None:
+        """Rebuild the saved mesh and step history in the loaded scene."""
+        scene = yade.O
+        self._enter_scene(scene)
+        self._core.resume(run, scene.dt)
+        self._bodies.stepped = self._bodies.rescan()
+        self._history.last_step = tuple(last_step)
+        registry.hold(self)
 
     # -- PFV extras -------------------------------------------------------------------------
     @property
@@ -751,7 +482,7 @@ class FlowEngine(BoundaryPressure, CellInterface, PyRunner):
 
 
 # Names set as ordinary attributes: PyRunner's (command, iterPeriod, label, ...) and the properties
-# of FlowEngine and its mixin.
+# of FlowEngine (its own and those forwarded to its parts).
 _OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
     name for klass in FlowEngine.__mro__ for name, v in vars(klass).items() if isinstance(v, property)}
 

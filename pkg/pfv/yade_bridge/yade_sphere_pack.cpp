@@ -1,4 +1,4 @@
-#include "pfv/python/yade_sphere_pack.hpp"
+#include "pfv/yade_bridge/yade_sphere_pack.hpp"
 
 #include <vector>
 
@@ -18,7 +18,7 @@ namespace py = pybind11;
 namespace pfv {
 namespace {
 
-// YADE 2023.02a, yade-double: SpherePack::Sph and the start of SpherePack.
+// The pinned YADE (yade_version.hpp), yade-double: SpherePack::Sph and the start of SpherePack.
 struct PackedSphere {
   double centre[3];
   double radius;

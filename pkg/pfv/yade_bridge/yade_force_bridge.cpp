@@ -1,4 +1,4 @@
-#include "pfv/python/yade_force_bridge.hpp"
+#include "pfv/yade_bridge/yade_force_bridge.hpp"
 
 #ifdef PFV_HAVE_BOOST_PYTHON
 #include <dlfcn.h>

@@ -5,7 +5,7 @@
 //
 // Debian's YADE ships no headers, so the pack's array is reached as the Vector3 storage in
 // yade_force_bridge.hpp is: through Boost.Python's converter registry, which YADE's bindings
-// populate, and then through the layout of YADE 2023.02a's class (first member
+// populate, and then through the layout of the pinned YADE's class (yade_version.hpp; first member
 // std::vector<Sph>, Sph = {Vector3r c; Real r; int clumpId}). A layout is a property of the
 // YADE build, not of the run: the caller checks it against YADE's Python interface (every
 // centre and radius) before trusting it, and reads the coordinate lists if it does not hold.

@@ -44,8 +44,8 @@ class StepWarnings:
                           "the pressures are not converged (raise the tolerance or use useSolver=3)", stacklevel=3)
         if inverted and self.once("inverted"):
             warnings.warn(f"pfv.FlowEngine: at iteration {iteration} spheres had moved so far since the last "
-                          "remesh that pore cells were turned inside out; remeshed (and will again whenever "
-                          "this happens). Lower meshUpdateInterval or defTolerance for motion this fast",
+                          "remesh that 2 % of the pore volume was turned inside out; remeshed (and will again "
+                          "whenever this happens). Lower meshUpdateInterval or defTolerance for motion this fast",
                           stacklevel=3)
         self._auto_multigrid(core, iteration)
         if watch.remeshing or inverted:

@@ -10,7 +10,7 @@
 
 #include "pfv/common/parallel.hpp"
 #include "pfv/common/stage_timer.hpp"
-#include "pfv/linalg/amg_solver.hpp"
+#include "pfv/engine/solver_policy.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/model/cell_queries.hpp"
 #include "pfv/snapshot/snapshot.hpp"
@@ -195,8 +195,7 @@ void FlowEngine::remesh_in_background(const std::vector<Vec3>& centres, const st
                                                      o = linear_.ordering, keep = auto_keeps_multigrid()]() {
     PoreMesh m = build_pore_mesh(c, r, w, s);
     CellConditions flat = flat_cells(m, s);
-    std::unique_ptr<PressureSolver> recycled;
-    if (keep) recycled = std::make_unique<AmgSolver>();
+    std::unique_ptr<PressureSolver> recycled = background_stand_in(keep);
     LinearSystem l = build_linear_system(m, b, s, dt, o.get(), std::move(recycled), {&flat});
     return Remesh{std::move(m), std::move(l), std::move(flat)};
   })};
@@ -277,21 +276,9 @@ bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditio
   return carried;
 }
 
-bool FlowEngine::auto_keeps_multigrid() const {
-  return settings.solver == SolverKind::kAuto && linear_.solver && linear_.solver->kind() == SolverKind::kMultigrid &&
-         linear_.recipe.max_factor_bytes == settings.max_factor_bytes;
-}
+bool FlowEngine::auto_keeps_multigrid() const { return pfv::auto_keeps_multigrid(settings, linear_); }
 
-std::unique_ptr<PressureSolver> FlowEngine::released_solver() {
-  // Under kAuto a multigrid solver carried over keeps the choice (build_linear_system); a new
-  // max_factor_bytes asks for it again.
-  const bool drop = settings.solver == SolverKind::kAuto && linear_.solver &&
-                    linear_.solver->kind() == SolverKind::kMultigrid && !auto_keeps_multigrid();
-  auto solver = std::move(linear_.solver);
-  if (solver) solver->release();
-  if (drop) solver.reset();
-  return solver;
-}
+std::unique_ptr<PressureSolver> FlowEngine::released_solver() { return release_solver(settings, linear_); }
 
 void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system) {
   // The old pressure at the new pore centres: the state of a compressible fluid, and the warm
@@ -456,7 +443,7 @@ void FlowEngine::solve() {
       const int c = system.unknown_cell[u];
       solution_[u] = trend ? 2 * next_pressure_[c] - pressure_before_[c] : next_pressure_[c];
     }
-    last_solve_ = solver.solve(system, rhs_, solution_, settings.solve_control());
+    last_solve_ = solver.solve(rhs_, solution_, settings.solve_control());
     keep_trend_ = solver.wants_extrapolated_start();  // false once promoted to a double factor
     for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
   }

@@ -81,7 +81,7 @@ void FlowEngine::apply_viscous_operator(const std::vector<double>& mass, const s
     for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = centres_prev_[shape.v[k]];
     rhs[u] = -(plus - minus) / (2 * h);
   }
-  linear_.solver->apply_inverse(system, rhs, x, settings.solve_control());
+  linear_.solver->apply_inverse(rhs, x, settings.solve_control());
   for (int u = 0; u < nu; ++u) p_cells[system.unknown_cell[u]] = x[u];
   mesh_->cache.apply(p_cells, force);
   if (mesh_->shear) mesh_->shear->add_velocity_forces(v, settings.viscosity_of_shear(), force, shear);

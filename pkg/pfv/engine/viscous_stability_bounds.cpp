@@ -12,15 +12,17 @@
 
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/engine/pore_mesh.hpp"
+#include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/linalg/refinement.hpp"
 
 namespace pfv {
 namespace {
 
 bool stieltjes(const PressureSystem& system) {
-  for (int col = 0; col < system.n_unknowns(); ++col)
-    for (int e = system.col_start[col]; e < system.col_start[col + 1]; ++e)
-      if (system.row[e] != col && system.value[e] > 0) return false;
+  const SymmetricMatrix& g = *system.matrix;
+  for (int col = 0; col < g.size(); ++col)
+    for (int e = g.col_start[col]; e < g.col_start[col + 1]; ++e)
+      if (g.row[e] != col && g.value[e] > 0) return false;
   return true;
 }
 
@@ -98,10 +100,13 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
   std::vector<double> z, correction, defect;
   SolveControl control = settings.solve_control();
   if (linear_.solver->kind() != SolverKind::kGaussSeidel) control.inverse_tolerance = kTolerance;
-  linear_.solver->apply_inverse(system, beta, z, control);
+  linear_.solver->apply_inverse(beta, z, control);
+  // G's rows where the factor's refinement keeps them, as its residual reads them.
+  const MatrixRows none;
+  const MatrixRows& g_rows = linear_.cholesky() ? linear_.cholesky()->rows() : none;
   double q = HUGE_VAL;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
-    residual(system, beta, z, defect);  // beta - G z
+    residual(*system.matrix, g_rows, beta, z, defect);  // beta - G z
     q = 0;
     for (int u = 0; u < nu && q < HUGE_VAL; ++u) {
       const double gz = beta[u] - defect[u];
@@ -109,7 +114,7 @@ double FlowEngine::viscous_stability_bound(const std::vector<double>& mass) cons
     }
     if (q <= kGoodScale) break;
     if (pass + 1 < kMaxPasses) {
-      linear_.solver->apply_inverse(system, defect, correction, control);
+      linear_.solver->apply_inverse(defect, correction, control);
       for (int u = 0; u < nu; ++u) z[u] += correction[u];
     }
   }

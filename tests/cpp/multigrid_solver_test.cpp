@@ -177,7 +177,8 @@ TEST(Multigrid, AnUnattainableToleranceStillStops) {
 }
 
 TEST(Multigrid, FullRowsAreTheSymmetricMatrix) {
-  const SymmetricMatrix& s = *test::random_spd(1500, 5);
+  const auto g = test::random_spd(1500, 5);
+  const SymmetricMatrix& s = *g;
   const DistributedRows rows = full_rows(s);
   const int n = s.size();
   ASSERT_EQ(rows.n_local(), n);

@@ -12,15 +12,15 @@ std::array<int, 4> CellOrdering::key_of(const std::array<int, 4>& vertices) {
   return k;
 }
 
-CellOrdering::CellOrdering(const CellGraph& mesh, const int* perm, SupernodalChains tree, double fresh_fill,
+CellOrdering::CellOrdering(const CellGraph& cells, const int* perm, SupernodalChains tree, double fresh_fill,
                            OrderingOrigin origin)
-    : n_spheres_(mesh.n_spheres),
-      n_(mesh.n_unknowns()),
+    : n_spheres_(cells.n_spheres),
+      n_(cells.n_unknowns()),
       tree_(std::move(tree)),
       fresh_fill_(fresh_fill),
       origin_(origin) {
   rank_.reserve(static_cast<std::size_t>(n_) * 2);
-  for (int k = 0; k < n_; ++k) rank_.emplace(key_of(mesh.vertices[mesh.unknown_cell[perm[k]]]), k);
+  for (int k = 0; k < n_; ++k) rank_.emplace(key_of(cells.vertices[cells.unknown_cell[perm[k]]]), k);
 }
 
 int CellOrdering::common_ancestor(int a, int b) const {
@@ -31,16 +31,16 @@ int CellOrdering::common_ancestor(int a, int b) const {
   return a < 0 ? n_ : std::max(a, b);                                             // different roots: last
 }
 
-std::vector<int> CellOrdering::carry_over(const CellGraph& mesh) const {
-  if (mesh.n_spheres != n_spheres_) return {};
-  const int nc = mesh.n_cells(), n = mesh.n_unknowns();
+std::vector<int> CellOrdering::carry_over(const CellGraph& cells) const {
+  if (cells.n_spheres != n_spheres_) return {};
+  const int nc = cells.n_cells(), n = cells.n_unknowns();
   constexpr int kUnknown = -1;
   // Old position of each cell; a new cell gets the position it is eliminated after.
   std::vector<int> position(nc, kUnknown);
   std::vector<char> is_new(nc, 0);
   std::vector<int> fresh;
   for (int c = 0; c < nc; ++c) {
-    const auto it = rank_.find(key_of(mesh.vertices[c]));
+    const auto it = rank_.find(key_of(cells.vertices[c]));
     if (it != rank_.end()) {
       position[c] = it->second;
     } else {
@@ -55,7 +55,7 @@ std::vector<int> CellOrdering::carry_over(const CellGraph& mesh) const {
     std::vector<int> still;
     for (int c : fresh) {
       int lo = n_, hi = kUnknown;  // over the neighbours placed in the old tree
-      for (int nb : mesh.neighbours[c])
+      for (int nb : cells.neighbours[c])
         if (nb >= 0 && position[nb] != kUnknown && position[nb] < n_) {
           lo = std::min(lo, position[nb]);
           hi = std::max(hi, position[nb]);
@@ -73,7 +73,7 @@ std::vector<int> CellOrdering::carry_over(const CellGraph& mesh) const {
   // Old cells keep their order; a new cell goes right after the position it was given.
   std::vector<long long> key(n);
   for (int u = 0; u < n; ++u) {
-    const int c = mesh.unknown_cell[u];
+    const int c = cells.unknown_cell[u];
     key[u] = 2LL * position[c] + is_new[c];
   }
   std::vector<int> order(n);

@@ -8,6 +8,7 @@
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/linalg/refinement.hpp"
+#include "test_matrices.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;
@@ -29,9 +30,9 @@ std::vector<double> solve(CholmodSolver& s, const std::vector<double>& b) {
 }  // namespace
 
 TEST(FactorStorage, ReusedStorageGivesTheFreshSolution) {
-  const PressureSystem small = test::permeameter_system(300, 3), large = test::permeameter_system(700, 4);
-  ASSERT_LT(small.n_unknowns(), large.n_unknowns());
-  const auto b = rhs(small.n_unknowns());
+  const SymmetricMatrix small = *test::grid_laplacian(10, 9, 8), large = *test::grid_laplacian(14, 13, 12);
+  ASSERT_LT(small.size(), large.size());
+  const auto b = rhs(small.size());
 
   CholmodSolver fresh;
   fresh.factorize(small, Ordering::kAmd);
@@ -60,7 +61,7 @@ TEST(FactorStorage, ReusedStorageGivesTheFreshSolution) {
   EXPECT_GT(grown.value_capacity(), before);
   CholmodSolver reference;
   reference.factorize(large, Ordering::kAmd);
-  const auto bl = rhs(large.n_unknowns());
+  const auto bl = rhs(large.size());
   EXPECT_EQ(solve(grown, bl), solve(reference, bl));
 }
 
@@ -96,12 +97,12 @@ TEST(FactorStorage, RemeshesFactoriseInTheStorageOfThePreviousFactor) {
 // exceeds it; CHOLMOD's own refusal of a larger one (CHOLMOD_TOO_LARGE, mapped to the same
 // exception) needs a million spheres: `bench/first_step_stages.py 1e6 --solvers=auto`.
 TEST(FactorStorage, AFactorBeyondTheIndexRangeIsRefused) {
-  const PressureSystem s = test::permeameter_system(400, 6);
+  const auto g = test::grid_laplacian(12, 11, 10);
   CholeskySolver solver;
-  FactorOptions options;
-  options.index_range = 1000;  // in place of 2^31 - 1: this system's factor exceeds it
+  SolverOptions options;
+  options.factor.index_range = 1000;  // in place of 2^31 - 1: this system's factor exceeds it
   try {
-    solver.setup(s, options);
+    solver.setup(g, options);
     FAIL() << "a factor beyond the index range was accepted";
   } catch (const FactorTooLarge& e) {
     EXPECT_EQ(e.why, FactorLimit::kIndexRange);
@@ -110,11 +111,11 @@ TEST(FactorStorage, AFactorBeyondTheIndexRangeIsRefused) {
     EXPECT_NE(std::string(e.what()).find("32-bit indices"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(solver.ready());
-  solver.setup(s, FactorOptions{});
+  solver.setup(g, SolverOptions{});
   ASSERT_TRUE(solver.ready());
-  std::vector<double> b(s.n_unknowns(), 1.0), x;
-  solver.solve(s, b, x, SolveControl{});
+  std::vector<double> b(g->size(), 1.0), x;
+  solver.solve(b, x, SolveControl{});
   std::vector<double> r;
-  residual(s, b, x, r);
+  residual(*g, MatrixRows{}, b, x, r);
   for (double v : r) EXPECT_LT(std::abs(v), 1e-9);
 }

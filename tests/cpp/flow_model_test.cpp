@@ -36,7 +36,8 @@ TEST(FlowModel, CholmodMatchesDenseSolve) {
   const int n = s.n_unknowns();
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
   for (int col = 0; col < n; ++col)
-    for (int q = s.col_start[col]; q < s.col_start[col + 1]; ++q) G(s.row[q], col) = G(col, s.row[q]) = s.value[q];
+    for (int q = s.matrix->col_start[col]; q < s.matrix->col_start[col + 1]; ++q)
+      G(s.matrix->row[q], col) = G(col, s.matrix->row[q]) = s.matrix->value[q];
   Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
   for (int u = 0; u < n; ++u) {
     const int c = s.unknown_cell[u];

@@ -50,10 +50,10 @@ TEST(GeometricOrdering, IsAPermutationOfTheUnknowns) {
   const FlowEngine e = solved(test::random_packing(600, 31), Ordering::kAuto);
   const int n = e.system().n_unknowns();
   ASSERT_GT(n, 2000);  // several levels of dissection at the default leaf size
-  EXPECT_TRUE(is_permutation_of_unknowns(geometric_ordering(e.system(), power_centres(e)), n));
+  EXPECT_TRUE(is_permutation_of_unknowns(geometric_ordering(*e.system().matrix, power_centres(e)), n));
   GeometricOrderingOptions tiny;
   tiny.leaf_size = 2;  // dissected down to pairs: every band and flow degenerate case is met
-  EXPECT_TRUE(is_permutation_of_unknowns(geometric_ordering(e.system(), power_centres(e), tiny), n));
+  EXPECT_TRUE(is_permutation_of_unknowns(geometric_ordering(*e.system().matrix, power_centres(e), tiny), n));
 }
 
 TEST(GeometricOrdering, TheSameOrderOnAnyNumberOfThreads) {
@@ -65,12 +65,12 @@ TEST(GeometricOrdering, TheSameOrderOnAnyNumberOfThreads) {
   tiny.leaf_size = 2;
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
-  const std::vector<int> serial = geometric_ordering(e.system(), point),
-                         serial_tiny = geometric_ordering(e.system(), point, tiny);
+  const std::vector<int> serial = geometric_ordering(*e.system().matrix, point),
+                         serial_tiny = geometric_ordering(*e.system().matrix, point, tiny);
   for (int t : {2, 3, 4}) {
     omp_set_num_threads(t);
-    EXPECT_EQ(geometric_ordering(e.system(), point), serial) << t << " threads";
-    EXPECT_EQ(geometric_ordering(e.system(), point, tiny), serial_tiny) << t << " threads";
+    EXPECT_EQ(geometric_ordering(*e.system().matrix, point), serial) << t << " threads";
+    EXPECT_EQ(geometric_ordering(*e.system().matrix, point, tiny), serial_tiny) << t << " threads";
   }
   omp_set_num_threads(threads);
 }
@@ -79,17 +79,17 @@ TEST(GeometricOrdering, CoincidentPointsStillGiveAPermutation) {
   // No plane separates anything: each split still halves the part by rank, and ends.
   const FlowEngine e = solved(test::random_packing(200, 32), Ordering::kAuto);
   const std::vector<std::array<double, 3>> same(e.system().n_unknowns(), {0.5, 0.5, 0.5});
-  EXPECT_TRUE(is_permutation_of_unknowns(geometric_ordering(e.system(), same), e.system().n_unknowns()));
+  EXPECT_TRUE(is_permutation_of_unknowns(geometric_ordering(*e.system().matrix, same), e.system().n_unknowns()));
 }
 
 TEST(GeometricOrdering, RejectsPointsThatDoNotMatchTheUnknowns) {
   const FlowEngine e = solved(test::random_packing(100, 33), Ordering::kAuto);
   auto point = power_centres(e);
   point.pop_back();
-  EXPECT_THROW(geometric_ordering(e.system(), point), std::invalid_argument);
+  EXPECT_THROW(geometric_ordering(*e.system().matrix, point), std::invalid_argument);
   point = power_centres(e);
   point[3][1] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(geometric_ordering(e.system(), point), std::invalid_argument);
+  EXPECT_THROW(geometric_ordering(*e.system().matrix, point), std::invalid_argument);
 }
 
 TEST(GeometricOrdering, FillsAboutAsLittleAsMetisAndFarLessThanAmd) {

@@ -10,6 +10,7 @@
 
 #include "pfv/engine/flow_engine.hpp"
 #include "pfv/engine/flow_queries.hpp"
+#include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/linalg/refinement.hpp"
 #include "test_packings.hpp"
 
@@ -25,13 +26,11 @@ double max_abs(const std::vector<double>& v) {
 
 // A chain of n cells between a Dirichlet cell (p = 0, folded into the diagonal) and a closed
 // end, whose conductances fall geometrically over 'decades': cond(G) ~ 10^decades.
-PressureSystem graded_chain(int n, double decades, double scale = 1) {
-  PressureSystem s;
-  s.unknown_cell.resize(n);
+SymmetricMatrix graded_chain(int n, double decades, double scale = 1) {
+  SymmetricMatrix s;
   s.col_start.push_back(0);
   const auto k = [&](int i) { return scale * std::pow(10.0, -decades * i / n); };  // throat i-1 -> i
   for (int j = 0; j < n; ++j) {
-    s.unknown_cell[j] = j;
     if (j > 0) {
       s.row.push_back(j - 1);
       s.value.push_back(-k(j));
@@ -44,7 +43,7 @@ PressureSystem graded_chain(int n, double decades, double scale = 1) {
 }
 
 // G^-1 b with CHOLMOD's double factor: the reference.
-std::vector<double> double_solve(const PressureSystem& s, const std::vector<double>& b) {
+std::vector<double> double_solve(const SymmetricMatrix& s, const std::vector<double>& b) {
   CholmodSolver exact;
   exact.factorize(s, Ordering::kAmd);
   std::vector<double> x;
@@ -134,8 +133,8 @@ TEST(MixedPrecision, LongChainConvergesDespiteItsConditionNumber) {
   // graph Laplacian (an M-matrix) whose stored factor stays a small perturbation of each
   // column: refinement still contracts. The conductance matrices of the pore network are all
   // of this kind.
-  const PressureSystem s = graded_chain(20000, 0);
-  std::vector<double> b(s.n_unknowns(), 0.0), x;
+  const SymmetricMatrix s = graded_chain(20000, 0);
+  std::vector<double> b(s.size(), 0.0), x;
   b.back() = 1e-10;  // a flux injected at the closed end
   const std::vector<double> x_exact = double_solve(s, b);
   CholmodSolver single;
@@ -143,7 +142,7 @@ TEST(MixedPrecision, LongChainConvergesDespiteItsConditionNumber) {
   ASSERT_TRUE(single.reduced_precision());
   Refinement r;
   x.assign(b.size(), 0.0);
-  ASSERT_TRUE(r.solve(s, single, b, x, 1e-10, 8));
+  ASSERT_TRUE(r.solve(s, MatrixRows{}, single, b, x, 1e-10, 8));
   EXPECT_LT(r.contraction(), 0.5);
   const double scale = max_abs(x_exact);
   for (std::size_t i = 0; i < x.size(); ++i) ASSERT_NEAR(x[i], x_exact[i], 1e-9 * scale);
@@ -164,8 +163,7 @@ TEST(MixedPrecision, IllConditionedDenseSystemIsDetectedAndSolvedInDouble) {
   Eigen::VectorXd lambda(n);
   for (int i = 0; i < n; ++i) lambda[i] = std::pow(10.0, -15.0 * i / (n - 1));
   const Eigen::MatrixXd g = q * lambda.asDiagonal() * q.transpose();
-  PressureSystem s;
-  s.unknown_cell.resize(n);
+  SymmetricMatrix s;
   s.col_start.push_back(0);
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i <= j; ++i) {
@@ -181,7 +179,7 @@ TEST(MixedPrecision, IllConditionedDenseSystemIsDetectedAndSolvedInDouble) {
   single.factorize(s, Ordering::kAmd, FactorPrecision::kScaled32);
   ASSERT_TRUE(single.reduced_precision());
   Refinement r;
-  EXPECT_FALSE(r.solve(s, single, b, x, 1e-10, 8));
+  EXPECT_FALSE(r.solve(s, MatrixRows{}, single, b, x, 1e-10, 8));
   single.promote_to_double(s);
   EXPECT_FALSE(single.reduced_precision());
   single.solve(b, x);
@@ -189,18 +187,18 @@ TEST(MixedPrecision, IllConditionedDenseSystemIsDetectedAndSolvedInDouble) {
 }
 
 TEST(MixedPrecision, WellConditionedChainConvergesFromAColdStart) {
-  const PressureSystem s = graded_chain(50, 1);  // cond ~ 1e4
-  std::vector<double> b(s.n_unknowns()), x(s.n_unknowns(), 0.0), r;
+  const SymmetricMatrix s = graded_chain(50, 1);  // cond ~ 1e4
+  std::vector<double> b(s.size()), x(s.size(), 0.0), r;
   for (std::size_t i = 0; i < b.size(); ++i) b[i] = std::cos(0.1 * i);
   const std::vector<double> x_exact = double_solve(s, b);
   CholmodSolver single;
   single.factorize(s, Ordering::kAmd, FactorPrecision::kScaled32);
   Refinement refine;
-  ASSERT_TRUE(refine.solve(s, single, b, x, 1e-12, 8));
+  ASSERT_TRUE(refine.solve(s, MatrixRows{}, single, b, x, 1e-12, 8));
   EXPECT_GE(refine.passes(), 2);  // one 32-bit solve alone is not accurate to 1e-12
   const double scale = max_abs(x_exact);
   for (std::size_t i = 0; i < x.size(); ++i) ASSERT_NEAR(x[i], x_exact[i], 1e-11 * scale);
-  residual(s, b, x, r);
+  residual(s, MatrixRows{}, b, x, r);
   EXPECT_LE(max_abs(r), 1e-13 * max_abs(x) * 2);  // round-off level: |G| <= 2 max k = 2
 }
 
@@ -208,14 +206,14 @@ TEST(MixedPrecision, FactorOfAnyMagnitudeKeepsItsPrecision) {
   // Each column carries its own double scale: conductances of 1e80 or 1e-80 (factor entries
   // 1e40, 1e-40, outside float's range) lose nothing to the 32-bit format.
   for (double scale : {1e80, 1e-80}) {
-    const PressureSystem s = graded_chain(100, 1, scale);
+    const SymmetricMatrix s = graded_chain(100, 1, scale);
     CholmodSolver solver;
     solver.factorize(s, Ordering::kAmd, FactorPrecision::kScaled32);
     EXPECT_TRUE(solver.reduced_precision()) << scale;
-    std::vector<double> b(s.n_unknowns(), scale), x(s.n_unknowns(), 0.0);
+    std::vector<double> b(s.size(), scale), x(s.size(), 0.0);
     const std::vector<double> x_exact = double_solve(s, b);
     Refinement refine;
-    ASSERT_TRUE(refine.solve(s, solver, b, x, 1e-12, 8)) << scale;
+    ASSERT_TRUE(refine.solve(s, MatrixRows{}, solver, b, x, 1e-12, 8)) << scale;
     EXPECT_LT(refine.contraction(), 1e-6) << scale;
     const double size = max_abs(x_exact);
     for (std::size_t i = 0; i < x.size(); ++i) ASSERT_NEAR(x[i], x_exact[i], 1e-11 * size) << scale;
@@ -301,22 +299,22 @@ TEST(MixedPrecision, ResidualByRowsEqualsResidualByColumns) {
   e.step(p.centre, p.radius, p.walls, 1.0);
   exact.step(p.centre, p.radius, p.walls, 1.0);
   ASSERT_TRUE(e.cholmod().reduced_precision());
-  EXPECT_TRUE(exact.system().row_diagonal.empty());
-  PressureSystem chain = graded_chain(60, 2);
-  index_rows(chain);
-  for (const PressureSystem* s : {&e.system(), static_cast<const PressureSystem*>(&chain)}) {
-    const int n = s->n_unknowns();
-    ASSERT_EQ(static_cast<int>(s->row_diagonal.size()), n);
-    EXPECT_EQ(s->row_width, s == &chain ? 2 : 4);
-    PressureSystem by_columns = *s;
-    by_columns.row_diagonal.clear();
+  EXPECT_TRUE(exact.cholesky()->rows().empty());
+  const SymmetricMatrix chain = graded_chain(60, 2);
+  const MatrixRows chain_rows = index_rows(chain);
+  const std::pair<const SymmetricMatrix*, const MatrixRows*> cases[] = {
+      {e.system().matrix.get(), &e.cholesky()->rows()}, {&chain, &chain_rows}};
+  for (const auto& [s, rows] : cases) {
+    const int n = s->size();
+    ASSERT_EQ(static_cast<int>(rows->diagonal.size()), n);
+    EXPECT_EQ(rows->width, s == &chain ? 2 : 4);
     std::vector<double> b(n), x(n), r_rows, r_columns;
     for (int i = 0; i < n; ++i) {
       b[i] = std::sin(0.7 * i);
       x[i] = std::cos(0.3 * i + 1);
     }
-    residual(*s, b, x, r_rows);
-    residual(by_columns, b, x, r_columns);
+    residual(*s, *rows, b, x, r_rows);
+    residual(*s, MatrixRows{}, b, x, r_columns);
     ASSERT_EQ(r_rows.size(), r_columns.size());
     double g_x = 0;  // the size of the terms summed: max |G| |x|
     for (double v : s->value) g_x = std::max(g_x, std::abs(v));

@@ -12,7 +12,7 @@
 
 #include "pfv/linalg/cholmod_solver.hpp"
 #include "pfv/linalg/page_prefault.hpp"
-#include "test_packings.hpp"
+#include "test_matrices.hpp"
 
 using namespace pfv;
 
@@ -92,12 +92,12 @@ TEST(PagePrefault, AnEmptyRangeStartsNothingAndStopIsIdempotent) {
 // A factor of more than 8 MB: its first factorisation runs with the helper populating the fresh
 // storage; factorising again reuses that storage without one. Both solve alike, bit for bit.
 TEST(PagePrefault, AFactorInPopulatedStorageSolvesAsInReusedStorage) {
-  const PressureSystem s = test::permeameter_system(2500, 8);
+  const SymmetricMatrix s = *test::grid_laplacian(26, 24, 22);
   CholmodSolver solver;
   solver.factorize(s, Ordering::kAmd);
   ASSERT_GE(solver.value_capacity() * sizeof(double), std::size_t{8} << 20) << "the factor must take the helper";
-  std::vector<double> b(s.n_unknowns()), first, second;
-  for (int i = 0; i < s.n_unknowns(); ++i) b[i] = std::cos(0.11 * i);
+  std::vector<double> b(s.size()), first, second;
+  for (int i = 0; i < s.size(); ++i) b[i] = std::cos(0.11 * i);
   solver.solve(b, first);
   const std::size_t capacity = solver.value_capacity();
   solver.factorize(s, Ordering::kAmd);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pfv/engine/flow_engine.hpp"
+#include "pfv/engine/solver_policy.hpp"
 #include "test_packings.hpp"
 
 using namespace pfv;
@@ -104,6 +105,8 @@ TEST(SettingsInvalidation, EachChangeRebuildsWhatTheTableSays) {
     SCOPED_TRACE(row.core);
     const auto edit = edits().find(row.core);
     ASSERT_NE(edit, edits().end()) << "no C++ edit for " << row.core;
+    // The small bound makes auto take multigrid, which a build without hypre does not have.
+    if (row.core == "max_factor_bytes" && !solver_unavailable(SolverKind::kMultigrid).empty()) continue;
     FlowEngine e = test::permeameter(0);
     e.step(p.centre, p.radius, p.walls, 1e-3);
     e.step(p.centre, p.radius, p.walls, 1e-3);

@@ -42,12 +42,4 @@ inline FlowEngine permeameter(int axis = 0, double p_in = 1.0) {
   return e;
 }
 
-// The assembled pressure system of a permeameter along y through a random packing of n spheres.
-inline PressureSystem permeameter_system(int n, unsigned seed) {
-  const auto p = random_packing(n, seed, 0.02, 0.035);
-  FlowEngine e = permeameter(1);
-  e.step(p.centre, p.radius, p.walls, 1.0);
-  return e.system();
-}
-
 }  // namespace pfv::test

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pfv/engine/solver_policy.hpp"
+
 namespace pfv {
 namespace {
 
@@ -32,9 +34,8 @@ void validate(const EngineSettings& s) {
   require(finite_positive(c.min_ratio), named("minKdivKmean", c.min_ratio, "positive and finite"));
   require(finite_positive(c.max_ratio) && c.max_ratio >= c.min_ratio,
           named("maxKdivKmean", c.max_ratio, "finite and at least minKdivKmean"));
-  require(s.solver == SolverKind::kGaussSeidel || s.solver == SolverKind::kConjugateGradient ||
-              s.solver == SolverKind::kCholesky || s.solver == SolverKind::kMultigrid || s.solver == SolverKind::kAuto,
-          "solver must be Gauss-Seidel, conjugate gradients, Cholesky, multigrid or auto");
+  const std::string unavailable = solver_unavailable(s.solver);
+  require(unavailable.empty(), unavailable);
   require(std::isfinite(s.shear_viscosity) && s.shear_viscosity >= 0,
           named("shear_viscosity", s.shear_viscosity, "finite and >= 0 (0: viscosity)"));
   require(std::isfinite(s.max_factor_bytes) && s.max_factor_bytes >= 0,

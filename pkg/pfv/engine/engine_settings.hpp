@@ -97,8 +97,8 @@ struct EngineSettings {
   // Whether a remesh carries the old mesh's cell states over (see interpolate_on_remesh), for
   // the solver in use: under kAuto the one chosen, which may be iterative.
   bool interpolates(SolverKind in_use) const {
-    return in_use == SolverKind::kGaussSeidel || in_use == SolverKind::kConjugateGradient ||
-           in_use == SolverKind::kMultigrid || fluid_bulk_modulus > 0 || interpolate_on_remesh;
+    const bool iterative = in_use != SolverKind::kCholesky && in_use != SolverKind::kAuto;
+    return iterative || fluid_bulk_modulus > 0 || interpolate_on_remesh;
   }
   // The ordering CHOLMOD is asked for.
   Ordering factor_ordering() const { return force_metis ? Ordering::kMetis : ordering; }

@@ -238,7 +238,7 @@ void FlowEngine::solve() {
       const int c = system.unknown_cell[u];
       solution_[u] = trend ? 2 * next_pressure_[c] - pressure_before_[c] : next_pressure_[c];
     }
-    last_solve_ = solver.solve(system, rhs_, solution_, settings.solve_control());
+    last_solve_ = solver.solve(rhs_, solution_, settings.solve_control());
     keep_trend_ = solver.wants_extrapolated_start();  // false once promoted to a double factor
     for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
   }

@@ -201,7 +201,7 @@ class FlowEngine {
   BoxWalls walls_prev_;
   bool has_prev_ = false;
   int remesh_count_ = 0;
-  int inverted_cells_ = 0;  // of the last assemble()
+  int inverted_cells_ = 0;                          // of the last assemble()
   double inverted_volume_ = 0, meshed_volume_ = 0;  // likewise: |volume| of those cells, and of all
   int inversion_remeshes_ = 0;
   int system_builds_ = 0;

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "pfv/engine/flow_engine.hpp"
+#include "pfv/engine/solver_policy.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/model/cell_queries.hpp"
 #include "pfv/snapshot/snapshot.hpp"
@@ -76,21 +77,9 @@ bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditio
   return carried;
 }
 
-bool FlowEngine::auto_keeps_multigrid() const {
-  return settings.solver == SolverKind::kAuto && linear_.solver && linear_.solver->kind() == SolverKind::kMultigrid &&
-         linear_.recipe.max_factor_bytes == settings.max_factor_bytes;
-}
+bool FlowEngine::auto_keeps_multigrid() const { return pfv::auto_keeps_multigrid(settings, linear_); }
 
-std::unique_ptr<PressureSolver> FlowEngine::released_solver() {
-  // Under kAuto a multigrid solver carried over keeps the choice (build_linear_system); a new
-  // max_factor_bytes asks for it again.
-  const bool drop = settings.solver == SolverKind::kAuto && linear_.solver &&
-                    linear_.solver->kind() == SolverKind::kMultigrid && !auto_keeps_multigrid();
-  auto solver = std::move(linear_.solver);
-  if (solver) solver->release();
-  if (drop) solver.reset();
-  return solver;
-}
+std::unique_ptr<PressureSolver> FlowEngine::released_solver() { return release_solver(settings, linear_); }
 
 void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system) {
   // The old pressure at the new pore centres: the state of a compressible fluid, and the warm

@@ -33,7 +33,7 @@ struct SystemRecipe {
   // kAuto: a new bound makes the choice again. A named Cholesky reads it at each factorisation
   // only (a held factor is not given up for a lower bound, and a refused one leaves no solver).
   double max_factor_bytes = 0;
-  MultigridSmoother multigrid_smoother = MultigridSmoother::kGaussSeidel;  // kMultigrid, kAuto
+  MultigridSmoother multigrid_smoother = MultigridSmoother::kGaussSeidel;  // see reads_multigrid_smoother
   double fluid_bulk_modulus = 0;
   double minimum_porosity = 0;  // enters G only with a compressible fluid
   double dt = 0;                // likewise
@@ -82,7 +82,7 @@ struct CellState {
 // (max_factor_bytes, else the memory available) or CHOLMOD's index range. previous: the ordering of the last
 // factorisation, tried first when settings.reuse_ordering (null: compute one). recycled: the
 // released solver of the previous system, reused (with the storage of its factor's values) if
-// it is of the kind the settings ask for.
+// it is of the kind the settings ask for (solver_policy.hpp).
 LinearSystem build_linear_system(const PoreMesh& mesh, const BoundaryConditions& bc, const EngineSettings& settings,
                                  double dt, const CellOrdering* previous = nullptr,
                                  std::unique_ptr<PressureSolver> recycled = nullptr, CellState cells = {});

@@ -3,7 +3,7 @@
 #include <chrono>
 #include <utility>
 
-#include "pfv/linalg/amg_solver.hpp"
+#include "pfv/engine/solver_policy.hpp"
 
 namespace pfv {
 
@@ -43,8 +43,7 @@ void Remesher::remesh_in_background(const std::vector<Vec3>& centres, const std:
                                                      o = std::move(ordering), keep = keep_multigrid]() {
     PoreMesh m = build_pore_mesh(c, r, w, s);
     CellConditions flat = flat_cells(m, s);
-    std::unique_ptr<PressureSolver> recycled;
-    if (keep) recycled = std::make_unique<AmgSolver>();
+    std::unique_ptr<PressureSolver> recycled = background_stand_in(keep);
     LinearSystem l = build_linear_system(m, b, s, dt, o.get(), std::move(recycled), {&flat});
     return Remesh{std::move(m), std::move(l), std::move(flat)};
   })};

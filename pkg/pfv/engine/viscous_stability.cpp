@@ -81,7 +81,7 @@ void apply_viscous_operator(const FlowEngine& e, const std::vector<double>& mass
     for (int k = 0; k < 4 - shape.n_walls; ++k) shifted[shape.v[k]] = e.positions()[shape.v[k]];
     rhs[u] = -(plus - minus) / (2 * h);
   }
-  e.linear_system().solver->apply_inverse(system, rhs, x, e.settings.solve_control());
+  e.linear_system().solver->apply_inverse(rhs, x, e.settings.solve_control());
   for (int u = 0; u < nu; ++u) p_cells[system.unknown_cell[u]] = x[u];
   e.pore_mesh().cache.apply(p_cells, force);
   if (e.pore_mesh().shear) e.pore_mesh().shear->add_velocity_forces(v, e.settings.viscosity_of_shear(), force, shear);

@@ -12,15 +12,17 @@
 
 #include "pfv/engine/pore_mesh.hpp"
 #include "pfv/engine/viscous_stability.hpp"
+#include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/linalg/refinement.hpp"
 
 namespace pfv {
 namespace {
 
 bool stieltjes(const PressureSystem& system) {
-  for (int col = 0; col < system.n_unknowns(); ++col)
-    for (int e = system.col_start[col]; e < system.col_start[col + 1]; ++e)
-      if (system.row[e] != col && system.value[e] > 0) return false;
+  const SymmetricMatrix& g = *system.matrix;
+  for (int col = 0; col < g.size(); ++col)
+    for (int e = g.col_start[col]; e < g.col_start[col + 1]; ++e)
+      if (g.row[e] != col && g.value[e] > 0) return false;
   return true;
 }
 
@@ -97,11 +99,15 @@ double viscous_stability_bound(const FlowEngine& e, const std::vector<double>& m
   constexpr int kMaxPasses = 6;
   std::vector<double> z, correction, defect;
   SolveControl control = e.settings.solve_control();
-  if (e.linear_system().solver->kind() != SolverKind::kGaussSeidel) control.inverse_tolerance = kTolerance;
-  e.linear_system().solver->apply_inverse(system, beta, z, control);
+  const LinearSystem& linear = e.linear_system();
+  if (linear.solver->kind() != SolverKind::kGaussSeidel) control.inverse_tolerance = kTolerance;
+  linear.solver->apply_inverse(beta, z, control);
+  // G's rows where the factor's refinement keeps them, as its residual reads them.
+  const MatrixRows none;
+  const MatrixRows& g_rows = linear.cholesky() ? linear.cholesky()->rows() : none;
   double q = HUGE_VAL;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
-    residual(system, beta, z, defect);  // beta - G z
+    residual(*system.matrix, g_rows, beta, z, defect);  // beta - G z
     q = 0;
     for (int u = 0; u < nu && q < HUGE_VAL; ++u) {
       const double gz = beta[u] - defect[u];
@@ -109,7 +115,7 @@ double viscous_stability_bound(const FlowEngine& e, const std::vector<double>& m
     }
     if (q <= kGoodScale) break;
     if (pass + 1 < kMaxPasses) {
-      e.linear_system().solver->apply_inverse(system, defect, correction, control);
+      linear.solver->apply_inverse(defect, correction, control);
       for (int u = 0; u < nu; ++u) z[u] += correction[u];
     }
   }

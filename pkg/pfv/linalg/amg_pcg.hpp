@@ -29,19 +29,9 @@
 #include <memory>
 #include <vector>
 
+#include "pfv/linalg/distributed_rows.hpp"
+
 namespace pfv {
-
-// Rows first_row .. first_row + n - 1 of a symmetric positive definite matrix, full rows
-// (both triangles) compressed by row, with global column indices.
-struct DistributedRows {
-  long long global_rows = 0;
-  int first_row = 0;
-  std::vector<int> row_start;  // n + 1 entries
-  std::vector<int> column;
-  std::vector<double> value;
-
-  int n_local() const { return row_start.empty() ? 0 : static_cast<int>(row_start.size()) - 1; }
-};
 
 // BoomerAMG's settings for a three-dimensional scalar diffusion operator (hypre's manual,
 // "BoomerAMG": HMIS coarsening with extended+i interpolation truncated to a few entries per row,

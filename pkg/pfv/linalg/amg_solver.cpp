@@ -1,45 +1,30 @@
 #include "pfv/linalg/amg_solver.hpp"
 
-#include "pfv/model/pressure_system.hpp"
+#include "pfv/linalg/distributed_rows.hpp"
 
 namespace pfv {
 
-DistributedRows full_rows(const PressureSystem& s) {
-  const int n = s.n_unknowns();
-  DistributedRows rows;
-  rows.global_rows = n;
-  rows.row_start.assign(n + 1, 0);
-  for (int j = 0; j < n; ++j)
-    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e) {
-      ++rows.row_start[s.row[e] + 1];
-      if (s.row[e] != j) ++rows.row_start[j + 1];
-    }
-  for (int i = 0; i < n; ++i) rows.row_start[i + 1] += rows.row_start[i];
-  rows.column.resize(rows.row_start[n]);
-  rows.value.resize(rows.row_start[n]);
-  std::vector<int> next(rows.row_start.begin(), rows.row_start.end() - 1);
-  // Entry (i, j <= i) of a column j is written to rows i and j (hypre sorts no columns and
-  // needs none sorted).
-  for (int j = 0; j < n; ++j)
-    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e) {
-      const int i = s.row[e];
-      rows.column[next[i]] = j;
-      rows.value[next[i]++] = s.value[e];
-      if (i != j) {
-        rows.column[next[j]] = i;
-        rows.value[next[j]++] = s.value[e];
-      }
-    }
-  return rows;
+AmgParameters amg_parameters(MultigridSmoother smoother) {
+  AmgParameters parameters;
+  if (smoother == MultigridSmoother::kJacobi) parameters.relax_type = 18;  // l1-scaled Jacobi
+  if (smoother == MultigridSmoother::kSplitGaussSeidel) {
+    parameters.relax_down = 13;  // l1-scaled Gauss-Seidel, forwards
+    parameters.relax_up = 14;    // and backwards: the adjoint, so the cycle stays symmetric
+  }
+  return parameters;
 }
 
-void AmgSolver::setup(const PressureSystem& system, const AmgParameters& parameters) {
+void AmgSolver::setup(std::shared_ptr<const SymmetricMatrix> g, const SolverOptions& options) {
+  setup(*g, amg_parameters(options.multigrid_smoother));
+}
+
+void AmgSolver::setup(const SymmetricMatrix& g, const AmgParameters& parameters) {
   pcg_.reset();
-  pcg_ = std::make_unique<AmgPcg>(MPI_COMM_SELF, full_rows(system), parameters);
+  n_ = g.size();
+  pcg_ = std::make_unique<AmgPcg>(MPI_COMM_SELF, full_rows(g), parameters);
 }
 
-SolveStats AmgSolver::solve(const PressureSystem&, const std::vector<double>& b, std::vector<double>& x,
-                            const SolveControl& control) {
+SolveStats AmgSolver::solve(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) {
   const AmgSolveStats s = pcg_->solve(b, x, control.refinement_tolerance, control.max_iterations);
   SolveStats stats;
   stats.cg_iterations = s.iterations;
@@ -47,9 +32,8 @@ SolveStats AmgSolver::solve(const PressureSystem&, const std::vector<double>& b,
   return stats;
 }
 
-void AmgSolver::apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
-                              const SolveControl& control) const {
-  x.assign(system.n_unknowns(), 0.0);
+void AmgSolver::apply_inverse(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) const {
+  x.assign(n_, 0.0);
   pcg_->solve_to_residual(b, x, control.inverse_tolerance, control.max_iterations);
 }
 

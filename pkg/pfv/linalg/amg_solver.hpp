@@ -2,7 +2,8 @@
 // preconditioned by BoomerAMG (amg_pcg.hpp) on this process, the hierarchy built once per
 // system, every solve warm-started from the pressures extrapolated from the last two steps and
 // stopped by the refinement's rule (within refinement_tolerance of the pressure spread). Its
-// memory grows as O(N): the choice when a Cholesky factor would not fit (linear_system.hpp).
+// memory grows as O(N): the choice when a Cholesky factor would not fit
+// (engine/solver_policy.hpp). Built only with hypre (PFV_WITH_HYPRE).
 #pragma once
 #include <memory>
 #include <vector>
@@ -12,17 +13,20 @@
 
 namespace pfv {
 
+// hypre's settings for a smoother of the V-cycle (its relax types).
+AmgParameters amg_parameters(MultigridSmoother smoother);
+
 class AmgSolver final : public PressureSolver {
  public:
-  // Throws std::runtime_error if hypre or MPI fails.
-  void setup(const PressureSystem& system, const AmgParameters& parameters = {});
+  // Reads options.multigrid_smoother. Throws std::runtime_error if hypre or MPI fails.
+  void setup(std::shared_ptr<const SymmetricMatrix> g, const SolverOptions& options) override;
+  // With hypre's settings given in full (tests, benchmarks).
+  void setup(const SymmetricMatrix& g, const AmgParameters& parameters);
   SolverKind kind() const override { return SolverKind::kMultigrid; }
   bool ready() const override { return pcg_ != nullptr; }
-  SolveStats solve(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
-                   const SolveControl& control) override;
-  // To |r| <= 1e-10 |b| from zero.
-  void apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
-                     const SolveControl& control) const override;
+  SolveStats solve(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) override;
+  // To control.inverse_tolerance (|r| / |b|) from zero.
+  void apply_inverse(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) const override;
   bool wants_extrapolated_start() const override { return true; }
   void release() override { pcg_.reset(); }
 
@@ -30,9 +34,7 @@ class AmgSolver final : public PressureSolver {
 
  private:
   std::unique_ptr<AmgPcg> pcg_;
+  int n_ = 0;
 };
-
-// G's full rows (both triangles) from its stored upper triangle: one process's whole matrix.
-DistributedRows full_rows(const PressureSystem& system);
 
 }  // namespace pfv

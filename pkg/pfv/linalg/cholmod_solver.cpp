@@ -15,7 +15,6 @@
 
 #include "pfv/common/parallel.hpp"
 #include "pfv/linalg/serial_openmp.hpp"
-#include "pfv/model/pressure_system.hpp"
 
 namespace pfv {
 
@@ -94,9 +93,9 @@ void CholmodSolver::print_statistics(const char* title) const {
 namespace {
 
 // A view of the assembled arrays; CHOLMOD only reads them.
-cholmod_sparse view_of(const PressureSystem& s) {
+cholmod_sparse view_of(const SymmetricMatrix& s) {
   cholmod_sparse a{};
-  a.nrow = a.ncol = s.n_unknowns();
+  a.nrow = a.ncol = s.size();
   a.nzmax = s.value.size();
   a.p = const_cast<int*>(s.col_start.data());
   a.i = const_cast<int*>(s.row.data());
@@ -112,11 +111,11 @@ cholmod_sparse view_of(const PressureSystem& s) {
 
 }  // namespace
 
-void CholmodSolver::factorize(const PressureSystem& s, Ordering ordering, FactorPrecision precision,
+void CholmodSolver::factorize(const SymmetricMatrix& s, Ordering ordering, FactorPrecision precision,
                               const GivenOrdering& given, double min_scaled_entries) {
   release();
   cholmod_common* c = &common_->c;
-  const int n = s.n_unknowns();
+  const int n = s.size();
   if (n == 0) return;
   c->postorder = 1;
   cholmod_sparse a = view_of(s);
@@ -235,10 +234,10 @@ void CholmodSolver::lend_values(void* factor) {
   f->minor = f->n;
 }
 
-void CholmodSolver::numeric_factorization(const PressureSystem& s) {
+void CholmodSolver::numeric_factorization(const SymmetricMatrix& s) {
   cholmod_common* c = &common_->c;
   auto* f = static_cast<cholmod_factor*>(factor_);
-  const int n = s.n_unknowns();
+  const int n = s.size();
   std::size_t minor = static_cast<std::size_t>(n);
   if (openmp_teams_ || !f->is_super || !f->x) {
     cholmod_sparse a = view_of(s);
@@ -278,7 +277,7 @@ void CholmodSolver::numeric_factorization(const PressureSystem& s) {
   }
 }
 
-void CholmodSolver::promote_to_double(const PressureSystem& s) {
+void CholmodSolver::promote_to_double(const SymmetricMatrix& s) {
   if (!factor_ || !reduced_precision()) return;
   std::vector<double>().swap(scale_);
   numeric_factorization(s);  // on the symbolic factor kept from the analysis; overwrites the 32-bit values
@@ -349,7 +348,7 @@ bool scale_to_int32(double* v, const cholmod_factor& f, const std::vector<long>&
 
 }  // namespace
 
-void CholmodSolver::plan_substitution(const PressureSystem& system, double min_scaled_entries) {
+void CholmodSolver::plan_substitution(const SymmetricMatrix& g, double min_scaled_entries) {
   auto* f = static_cast<cholmod_factor*>(factor_);
   if (!f->is_super || !f->is_ll) {  // CHOLMOD_SUPERNODAL is requested in the constructor
     release();
@@ -368,7 +367,7 @@ void CholmodSolver::plan_substitution(const PressureSystem& system, double min_s
   // Small factors stay double: they are served from the caches, where 32 bits gain nothing.
   if (trapezoid_start_.back() >= min_scaled_entries && !scale_to_int32(v, *f, trapezoid_start_, scale_)) {
     std::vector<double>().swap(scale_);  // stay double: factorise again, the values were overwritten
-    numeric_factorization(system);
+    numeric_factorization(g);
     v = static_cast<double*>(f->x);
     trapezoid_start_ = compact_to_trapezoids(v, *f);
   }

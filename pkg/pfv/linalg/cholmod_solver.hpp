@@ -11,10 +11,9 @@
 #include "pfv/linalg/page_prefault.hpp"
 #include "pfv/linalg/parallel_substitution.hpp"
 #include "pfv/linalg/supernodal_numeric.hpp"
+#include "pfv/linalg/symmetric_matrix.hpp"
 
 namespace pfv {
-
-struct PressureSystem;
 
 // The elimination tree of a supernodal factor, in elimination positions: the columns of a
 // supernode form a chain ending at chain_end; parent[chain_end] is the first column below the
@@ -93,11 +92,11 @@ class CholmodSolver {
   // because the format's error bound assumes it).
   // 'ordering' is computed unless 'given' is accepted.
   // kScaled32 applies to factors of at least min_scaled_entries stored entries (after compaction).
-  void factorize(const PressureSystem& system, Ordering ordering, FactorPrecision precision = FactorPrecision::kDouble,
+  void factorize(const SymmetricMatrix& g, Ordering ordering, FactorPrecision precision = FactorPrecision::kDouble,
                  const GivenOrdering& given = {}, double min_scaled_entries = 0);
   // Refactorises in double on the same ordering (no new analysis): for when refinement with
   // the 32-bit factor does not converge (G too ill-conditioned for it).
-  void promote_to_double(const PressureSystem& system);
+  void promote_to_double(const SymmetricMatrix& g);
   // x ~ G^-1 rhs; exact to round-off in double, an approximate inverse with kScaled32.
   // Always PFV's own substitution (parallel_substitution.hpp) on the compacted factor, whose
   // values CHOLMOD can no longer read: with two or more OpenMP threads on subtrees in parallel.
@@ -141,11 +140,11 @@ class CholmodSolver {
 
  private:
   void solve_on(const std::vector<double>& rhs, std::vector<double>& x, bool threads);
-  void numeric_factorization(const PressureSystem& system);
+  void numeric_factorization(const SymmetricMatrix& g);
   void lend_values(void* factor);  // cholmod_factor*, after the analysis
   // Compacts the factor, converts it to kScaled32 if it has at least min_scaled_entries entries
   // (kNever: stays double), and plans the substitution.
-  void plan_substitution(const PressureSystem& system, double min_scaled_entries);
+  void plan_substitution(const SymmetricMatrix& g, double min_scaled_entries);
   static constexpr double kNever = std::numeric_limits<double>::infinity();
   struct Common;
   Common* common_;

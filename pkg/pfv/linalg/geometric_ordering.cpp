@@ -14,7 +14,6 @@
 #include <string>
 
 #include "pfv/common/parallel.hpp"
-#include "pfv/model/pressure_system.hpp"
 
 namespace pfv {
 
@@ -25,8 +24,8 @@ struct Graph {
   std::vector<int> start, next;
 };
 
-Graph symmetric_pattern(const PressureSystem& s) {
-  const int n = s.n_unknowns();
+Graph symmetric_pattern(const SymmetricMatrix& s) {
+  const int n = s.size();
   Graph g;
   g.start.assign(n + 1, 0);
   for (int j = 0; j < n; ++j)
@@ -399,9 +398,9 @@ class Dissection {
 
 }  // namespace
 
-std::vector<int> geometric_ordering(const PressureSystem& s, const std::vector<std::array<double, 3>>& point,
+std::vector<int> geometric_ordering(const SymmetricMatrix& s, const std::vector<std::array<double, 3>>& point,
                                     const GeometricOrderingOptions& options) {
-  const int n = s.n_unknowns();
+  const int n = s.size();
   if (static_cast<int>(point.size()) != n)
     throw std::invalid_argument("geometric ordering: " + std::to_string(point.size()) + " points for " +
                                 std::to_string(n) + " unknowns");

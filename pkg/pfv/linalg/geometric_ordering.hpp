@@ -19,9 +19,9 @@
 #include <array>
 #include <vector>
 
-namespace pfv {
+#include "pfv/linalg/symmetric_matrix.hpp"
 
-struct PressureSystem;
+namespace pfv {
 
 struct GeometricOrderingOptions {
   int leaf_size = 64;  // parts of at most this many unknowns (at least 2) are not split further
@@ -29,9 +29,9 @@ struct GeometricOrderingOptions {
   double band_layers = 2;
 };
 
-// perm[k] = unknown eliminated k-th, for system's G; point[u] is a point of unknown u's cell.
+// perm[k] = unknown eliminated k-th, for G; point[u] is a point of unknown u's cell.
 // Throws std::invalid_argument if point has not one entry per unknown.
-std::vector<int> geometric_ordering(const PressureSystem& system, const std::vector<std::array<double, 3>>& point,
+std::vector<int> geometric_ordering(const SymmetricMatrix& g, const std::vector<std::array<double, 3>>& point,
                                     const GeometricOrderingOptions& options = {});
 
 }  // namespace pfv

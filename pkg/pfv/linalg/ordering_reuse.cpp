@@ -4,8 +4,6 @@
 #include <numeric>
 #include <utility>
 
-#include "pfv/model/pressure_system.hpp"
-
 namespace pfv {
 
 std::array<int, 4> CellOrdering::key_of(const std::array<int, 4>& vertices) {
@@ -14,11 +12,15 @@ std::array<int, 4> CellOrdering::key_of(const std::array<int, 4>& vertices) {
   return k;
 }
 
-CellOrdering::CellOrdering(const Mesh& mesh, const PressureSystem& s, const int* perm, SupernodalChains tree,
-                           double fresh_fill, OrderingOrigin origin)
-    : n_spheres_(mesh.n_spheres), n_(s.n_unknowns()), tree_(std::move(tree)), fresh_fill_(fresh_fill), origin_(origin) {
+CellOrdering::CellOrdering(const CellGraph& cells, const int* perm, SupernodalChains tree, double fresh_fill,
+                           OrderingOrigin origin)
+    : n_spheres_(cells.n_spheres),
+      n_(cells.n_unknowns()),
+      tree_(std::move(tree)),
+      fresh_fill_(fresh_fill),
+      origin_(origin) {
   rank_.reserve(static_cast<std::size_t>(n_) * 2);
-  for (int k = 0; k < n_; ++k) rank_.emplace(key_of(mesh.cell_vertices[s.unknown_cell[perm[k]]]), k);
+  for (int k = 0; k < n_; ++k) rank_.emplace(key_of(cells.vertices[cells.unknown_cell[perm[k]]]), k);
 }
 
 int CellOrdering::common_ancestor(int a, int b) const {
@@ -29,16 +31,16 @@ int CellOrdering::common_ancestor(int a, int b) const {
   return a < 0 ? n_ : std::max(a, b);                                             // different roots: last
 }
 
-std::vector<int> CellOrdering::carry_over(const Mesh& mesh, const PressureSystem& s) const {
-  if (mesh.n_spheres != n_spheres_) return {};
-  const int nc = mesh.n_cells(), n = s.n_unknowns();
+std::vector<int> CellOrdering::carry_over(const CellGraph& cells) const {
+  if (cells.n_spheres != n_spheres_) return {};
+  const int nc = cells.n_cells(), n = cells.n_unknowns();
   constexpr int kUnknown = -1;
   // Old position of each cell; a new cell gets the position it is eliminated after.
   std::vector<int> position(nc, kUnknown);
   std::vector<char> is_new(nc, 0);
   std::vector<int> fresh;
   for (int c = 0; c < nc; ++c) {
-    const auto it = rank_.find(key_of(mesh.cell_vertices[c]));
+    const auto it = rank_.find(key_of(cells.vertices[c]));
     if (it != rank_.end()) {
       position[c] = it->second;
     } else {
@@ -53,7 +55,7 @@ std::vector<int> CellOrdering::carry_over(const Mesh& mesh, const PressureSystem
     std::vector<int> still;
     for (int c : fresh) {
       int lo = n_, hi = kUnknown;  // over the neighbours placed in the old tree
-      for (int nb : mesh.cell_neighbours[c])
+      for (int nb : cells.neighbours[c])
         if (nb >= 0 && position[nb] != kUnknown && position[nb] < n_) {
           lo = std::min(lo, position[nb]);
           hi = std::max(hi, position[nb]);
@@ -71,7 +73,7 @@ std::vector<int> CellOrdering::carry_over(const Mesh& mesh, const PressureSystem
   // Old cells keep their order; a new cell goes right after the position it was given.
   std::vector<long long> key(n);
   for (int u = 0; u < n; ++u) {
-    const int c = s.unknown_cell[u];
+    const int c = cells.unknown_cell[u];
     key[u] = 2LL * position[c] + is_new[c];
   }
   std::vector<int> order(n);

@@ -16,24 +16,22 @@
 #include <unordered_map>
 #include <vector>
 
+#include "pfv/linalg/cell_graph.hpp"
 #include "pfv/linalg/cholmod_solver.hpp"
-#include "triangulation/mesh.hpp"
 
 namespace pfv {
 
-struct PressureSystem;
-
 class CellOrdering {
  public:
-  // From a factorisation of 'system' on 'mesh': its elimination order perm (perm[k] = unknown
-  // eliminated k-th) and tree; fresh_fill = factor entries per unknown of the last ordering
-  // computed from scratch (this one, or the one it descends from).
-  CellOrdering(const Mesh& mesh, const PressureSystem& system, const int* perm, SupernodalChains tree,
-               double fresh_fill, OrderingOrigin origin);
+  // From a factorisation of G over the unknowns of 'cells': its elimination order perm
+  // (perm[k] = unknown eliminated k-th) and tree; fresh_fill = factor entries per unknown of the
+  // last ordering computed from scratch (this one, or the one it descends from).
+  CellOrdering(const CellGraph& cells, const int* perm, SupernodalChains tree, double fresh_fill,
+               OrderingOrigin origin);
 
   // The elimination order carried over to a new mesh of the same spheres, or empty if the
   // spheres changed (then nothing can be matched).
-  std::vector<int> carry_over(const Mesh& mesh, const PressureSystem& system) const;
+  std::vector<int> carry_over(const CellGraph& cells) const;
   double fresh_fill() const { return fresh_fill_; }
   OrderingOrigin origin() const { return origin_; }
 

@@ -4,12 +4,10 @@
 #include <Eigen/SparseCore>
 #include <stdexcept>
 
-#include "pfv/model/pressure_system.hpp"
-
 namespace pfv {
 
 struct PcgSolver::Impl {
-  Eigen::SparseMatrix<double> g;  // upper triangle, as assembled
+  Eigen::SparseMatrix<double> g;  // G's upper triangle, copied: the factorisation reads it
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::IncompleteCholesky<double, Eigen::Upper>>
       cg;
   bool ready = false;
@@ -35,8 +33,9 @@ bool PcgSolver::ready() const { return impl_->ready; }
 
 void PcgSolver::release() { impl_ = std::make_unique<Impl>(); }
 
-void PcgSolver::setup(const PressureSystem& s) {
-  const int n = s.n_unknowns();
+void PcgSolver::setup(std::shared_ptr<const SymmetricMatrix> matrix, const SolverOptions&) {
+  const SymmetricMatrix& s = *matrix;
+  const int n = s.size();
   impl_->ready = false;
   impl_->g = Eigen::Map<const Eigen::SparseMatrix<double>>(n, n, static_cast<Eigen::Index>(s.value.size()),
                                                            s.col_start.data(), s.row.data(), s.value.data());
@@ -46,8 +45,7 @@ void PcgSolver::setup(const PressureSystem& s) {
   impl_->ready = true;
 }
 
-SolveStats PcgSolver::solve(const PressureSystem&, const std::vector<double>& b, std::vector<double>& x,
-                            const SolveControl& control) {
+SolveStats PcgSolver::solve(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) {
   SolveStats stats;
   const auto [iterations, error] = impl_->run(b, x, control.tolerance, control.max_iterations);
   stats.cg_iterations = iterations;
@@ -56,9 +54,8 @@ SolveStats PcgSolver::solve(const PressureSystem&, const std::vector<double>& b,
   return stats;
 }
 
-void PcgSolver::apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
-                              const SolveControl& control) const {
-  x.assign(system.n_unknowns(), 0.0);
+void PcgSolver::apply_inverse(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) const {
+  x.assign(impl_->g.rows(), 0.0);
   impl_->run(b, x, control.inverse_tolerance, control.max_iterations);
 }
 

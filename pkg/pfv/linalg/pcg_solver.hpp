@@ -17,15 +17,13 @@ class PcgSolver final : public PressureSolver {
   PcgSolver& operator=(const PcgSolver&) = delete;
 
   // Throws std::domain_error if the preconditioner cannot be built (a singular system).
-  void setup(const PressureSystem& system);
+  void setup(std::shared_ptr<const SymmetricMatrix> g, const SolverOptions& options) override;
   SolverKind kind() const override { return SolverKind::kConjugateGradient; }
   bool ready() const override;
   // Stops at |r| <= tolerance |b|.
-  SolveStats solve(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
-                   const SolveControl& control) override;
-  // To |r| <= 1e-10 |b| from zero.
-  void apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
-                     const SolveControl& control) const override;
+  SolveStats solve(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) override;
+  // To control.inverse_tolerance from zero.
+  void apply_inverse(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) const override;
   void release() override;
   double error() const { return error_; }  // |r| / |b| of the last solve
 

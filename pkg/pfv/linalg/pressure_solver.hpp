@@ -3,26 +3,23 @@
 // extension, useSolver=1), the sparse Cholesky factor (useSolver=3) and conjugate gradients
 // with an algebraic multigrid preconditioner (a PFV extension, amg_solver.hpp). kAuto, the
 // default, is the Cholesky factor unless it would not fit in memory or would cost more per
-// step than multigrid (linear_system.hpp); it names a choice, never a solver.
+// step than multigrid (engine/solver_policy.hpp); it names a choice, never a solver.
 //
-// A solver is prepared once per system (setup: a factorisation, a preconditioner, nothing)
-// and then solves many right-hand sides: one per DEM step between two remeshes.
+// As MFEM's Solver (SetOperator, then Mult): a solver is set up once per system with G (a
+// factorisation, a preconditioner, nothing), keeps G, and then solves many right-hand sides
+// with it: one per DEM step between two remeshes. Which solver, and when, is the engine's
+// solver policy (engine/solver_policy.hpp).
 #pragma once
 #include <memory>
 #include <string_view>
 #include <vector>
 
+#include "pfv/linalg/solver_options.hpp"
+#include "pfv/linalg/symmetric_matrix.hpp"
+
 namespace pfv {
 
-struct PressureSystem;
-
 enum class SolverKind { kGaussSeidel, kConjugateGradient, kCholesky, kMultigrid, kAuto };
-
-// The smoother of the multigrid V-cycle (amg_pcg.hpp): hypre's symmetric l1-Gauss-Seidel sweep
-// pair on the way down and up; its l1-scaled Jacobi; or kSplitGaussSeidel, one forward
-// Gauss-Seidel sweep on the way down and one backward sweep on the way up (the cycle stays
-// symmetric, with half the sweeps of kGaussSeidel).
-enum class MultigridSmoother { kGaussSeidel, kJacobi, kSplitGaussSeidel };
 
 // The smoother's name in the Python API: gauss_seidel, jacobi, split_gauss_seidel.
 std::string_view to_string(MultigridSmoother smoother);
@@ -54,20 +51,22 @@ class PressureSolver {
  public:
   virtual ~PressureSolver() = default;
   virtual SolverKind kind() const = 0;
-  // Ready for solve() on the system it was set up for.
+  // Prepares the solves with G (of at least one unknown) and keeps it for them; throws as each
+  // solver says, and is then not ready().
+  virtual void setup(std::shared_ptr<const SymmetricMatrix> g, const SolverOptions& options) = 0;
+  // Ready for solve() with the G it was set up with.
   virtual bool ready() const = 0;
   // x (one entry per unknown) holds the start on entry and the solution on return; b includes
   // the couplings to the Dirichlet cells.
-  virtual SolveStats solve(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
-                           const SolveControl& control) = 0;
+  virtual SolveStats solve(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) = 0;
   // x ~ G^-1 b to control.inverse_tolerance (exact with a factor), from x = 0, without changing
   // what the next solve() does: the stability limit's operator.
-  virtual void apply_inverse(const PressureSystem& system, const std::vector<double>& b, std::vector<double>& x,
+  virtual void apply_inverse(const std::vector<double>& b, std::vector<double>& x,
                              const SolveControl& control) const = 0;
   // Whether the next solve() should start from pressures extrapolated from the last two steps
   // rather than the last step's (refinement: it halves the first correction in a smooth motion).
   virtual bool wants_extrapolated_start() const { return false; }
-  // Frees what was built for the last system, keeping what the next setup can reuse.
+  // Frees what was built for the last system, G included, keeping what the next setup can reuse.
   virtual void release() {}
 };
 

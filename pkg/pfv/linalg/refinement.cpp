@@ -5,7 +5,6 @@
 
 #include "pfv/common/parallel.hpp"
 #include "pfv/linalg/cholmod_solver.hpp"
-#include "pfv/model/pressure_system.hpp"
 
 namespace pfv {
 namespace {
@@ -16,18 +15,18 @@ double max_abs(const std::vector<double>& v) {
   return m;
 }
 
-// r = b - G x from the rows (PressureSystem::row_width etc.); W > 0 fixes the width at compile time.
+// r = b - G x from G's rows; W > 0 fixes the width at compile time.
 template <int W>
-void residual_by_rows(const PressureSystem& s, const std::vector<double>& b, const std::vector<double>& x,
+void residual_by_rows(const MatrixRows& s, const std::vector<double>& b, const std::vector<double>& x,
                       std::vector<double>& r) {
-  const int n = s.n_unknowns();
-  const int w = W > 0 ? W : s.row_width;
+  const int n = static_cast<int>(s.diagonal.size());
+  const int w = W > 0 ? W : s.width;
   r.resize(n);
 #pragma omp parallel for schedule(static) if (n > kMinParallelLoop)
   for (int u = 0; u < n; ++u) {
-    const int* column = s.row_column.data() + static_cast<std::size_t>(u) * w;
-    const double* value = s.row_value.data() + static_cast<std::size_t>(u) * w;
-    double gx = s.row_diagonal[u] * x[u];
+    const int* column = s.column.data() + static_cast<std::size_t>(u) * w;
+    const double* value = s.value.data() + static_cast<std::size_t>(u) * w;
+    double gx = s.diagonal[u] * x[u];
     for (int f = 0; f < w; ++f) gx += value[f] * x[column[f]];
     r[u] = b[u] - gx;
   }
@@ -35,14 +34,14 @@ void residual_by_rows(const PressureSystem& s, const std::vector<double>& b, con
 
 }  // namespace
 
-void residual(const PressureSystem& s, const std::vector<double>& b, const std::vector<double>& x,
-              std::vector<double>& r) {
-  const int n = s.n_unknowns();
-  if (static_cast<int>(s.row_diagonal.size()) == n && n > 0) {
-    if (s.row_width == 4)
-      residual_by_rows<4>(s, b, x, r);
+void residual(const SymmetricMatrix& s, const MatrixRows& rows, const std::vector<double>& b,
+              const std::vector<double>& x, std::vector<double>& r) {
+  const int n = s.size();
+  if (static_cast<int>(rows.diagonal.size()) == n && n > 0) {
+    if (rows.width == 4)
+      residual_by_rows<4>(rows, b, x, r);
     else
-      residual_by_rows<0>(s, b, x, r);
+      residual_by_rows<0>(rows, b, x, r);
     return;
   }
   r.assign(b.begin(), b.end());
@@ -59,10 +58,10 @@ void residual(const PressureSystem& s, const std::vector<double>& b, const std::
   }
 }
 
-double Refinement::estimate_contraction(const PressureSystem& s, CholmodSolver& m) {
+double Refinement::estimate_contraction(const SymmetricMatrix& s, const MatrixRows& rows, CholmodSolver& m) {
   // Power iteration on E = I - M^-1 G from a pseudo-random start that has a component along
   // every eigenvector; the ratio of successive norms tends to rho(E) from below.
-  const int n = s.n_unknowns();
+  const int n = s.size();
   std::vector<double>& v = correction_;
   std::vector<double> zero(n, 0.0), gv;
   v.resize(n);
@@ -70,8 +69,8 @@ double Refinement::estimate_contraction(const PressureSystem& s, CholmodSolver& 
   double norm = max_abs(v), ratio = 0;
   for (int it = 0; it < kPowerIterations; ++it) {
     for (double& x : v) x /= norm;
-    residual(s, zero, v, residual_);  // -G v
-    m.solve(residual_, gv);           // -M^-1 G v
+    residual(s, rows, zero, v, residual_);  // -G v
+    m.solve(residual_, gv);                 // -M^-1 G v
     for (int i = 0; i < n; ++i) v[i] += gv[i];
     const double next = max_abs(v);
     ratio = next;  // |E v| / |v| with |v| = 1
@@ -81,16 +80,16 @@ double Refinement::estimate_contraction(const PressureSystem& s, CholmodSolver& 
   return ratio;
 }
 
-bool Refinement::solve(const PressureSystem& s, CholmodSolver& m, const std::vector<double>& b, std::vector<double>& x,
-                       double tolerance, int max_passes) {
+bool Refinement::solve(const SymmetricMatrix& s, const MatrixRows& rows, CholmodSolver& m, const std::vector<double>& b,
+                       std::vector<double>& x, double tolerance, int max_passes) {
   // Corrections this small (relative to x) are round-off: their ratios say nothing about rho.
   constexpr double kRoundOff = 1e-13;
-  if (rho_ < 0) rho_ = seed_ > 0 ? seed_ : std::max(kSafety * estimate_contraction(s, m), 1e-12);
+  if (rho_ < 0) rho_ = seed_ > 0 ? seed_ : std::max(kSafety * estimate_contraction(s, rows, m), 1e-12);
   if (rho_ >= 0.5) return false;
   double previous = 0;
   passes_ = 0;
   while (passes_ < max_passes) {
-    residual(s, b, x, residual_);
+    residual(s, rows, b, x, residual_);
     m.solve(residual_, correction_);
     for (std::size_t i = 0; i < x.size(); ++i) x[i] += correction_[i];
     ++passes_;

@@ -16,10 +16,12 @@
 #pragma once
 #include <vector>
 
+#include "pfv/linalg/matrix_rows.hpp"
+#include "pfv/linalg/symmetric_matrix.hpp"
+
 namespace pfv {
 
 class CholmodSolver;
-struct PressureSystem;
 
 class Refinement {
  public:
@@ -31,11 +33,12 @@ class Refinement {
   // mesh starts cold (two passes or more), so a pass contracting less than the seed raises rho
   // as below. (One power iteration is no check: from the fixed start its ratio is 20x rho.)
   void seed(double rho) { seed_ = rho; }
-  // x holds the starting guess on entry. Returns false if the passes stop contracting
+  // rows: G by rows (index_rows), or empty to read its columns. x holds the starting guess on
+  // entry. Returns false if the passes stop contracting
   // (rho >= 1/2: G is too ill-conditioned for the rounded factor) or max_passes is reached;
   // x is then unspecified.
-  bool solve(const PressureSystem& system, CholmodSolver& factor, const std::vector<double>& b, std::vector<double>& x,
-             double tolerance, int max_passes);
+  bool solve(const SymmetricMatrix& g, const MatrixRows& rows, CholmodSolver& factor, const std::vector<double>& b,
+             std::vector<double>& x, double tolerance, int max_passes);
   int passes() const { return passes_; }
   double contraction() const { return rho_; }  // -1 until measured
 
@@ -43,16 +46,15 @@ class Refinement {
   static constexpr double kSafety = 4;
 
  private:
-  double estimate_contraction(const PressureSystem& system, CholmodSolver& factor);
+  double estimate_contraction(const SymmetricMatrix& g, const MatrixRows& rows, CholmodSolver& factor);
 
   std::vector<double> residual_, correction_;
   double rho_ = -1, seed_ = -1;
   int passes_ = 0;
 };
 
-// r = b - G x: from G's rows (PressureSystem::row_width ..., filled by index_rows), else from
-// its upper triangle by column (col_start/row/value).
-void residual(const PressureSystem& system, const std::vector<double>& b, const std::vector<double>& x,
-              std::vector<double>& r);
+// r = b - G x: from G's rows unless rows is empty, else from its upper triangle by column.
+void residual(const SymmetricMatrix& g, const MatrixRows& rows, const std::vector<double>& b,
+              const std::vector<double>& x, std::vector<double>& r);
 
 }  // namespace pfv

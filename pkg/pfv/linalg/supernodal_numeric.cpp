@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cstddef>
 
-#include "pfv/model/pressure_system.hpp"
-
 // BLAS and LAPACK (Debian's libblas3 / liblapack3 alternatives, as CHOLMOD uses them), with
 // gfortran's hidden string lengths.
 extern "C" {
@@ -46,7 +44,7 @@ void update_block(const double* a, int lda, int rows, int cols, int width, doubl
 
 }  // namespace
 
-int supernodal_numeric(const SupernodalSymbolic& L, const PressureSystem& g, double* values, SupernodalWorkspace& w) {
+int supernodal_numeric(const SupernodalSymbolic& L, const SymmetricMatrix& g, double* values, SupernodalWorkspace& w) {
   const int n = L.n, ns = L.nsuper;
   // G's entries by column of P G P' lower triangle: the column is the earlier of the two
   // elimination positions of an entry of G's upper triangle, the row the later.

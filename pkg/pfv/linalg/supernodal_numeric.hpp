@@ -12,9 +12,9 @@
 #pragma once
 #include <vector>
 
-namespace pfv {
+#include "pfv/linalg/symmetric_matrix.hpp"
 
-struct PressureSystem;
+namespace pfv {
 
 // CHOLMOD's supernodal symbolic factor (cholmod_factor with itype CHOLMOD_INT): supernode s
 // holds columns super[s]..super[s+1]-1 (elimination order) and rows rows[pi[s]..pi[s+1]-1],
@@ -39,7 +39,7 @@ struct SupernodalWorkspace {
 // Writes L into values (the layout of SupernodalSymbolic; the strict upper triangles of the
 // diagonal blocks are left as they are). Returns -1, or the elimination position of the first
 // pivot that is not positive (G not positive definite; values are then incomplete).
-int supernodal_numeric(const SupernodalSymbolic& symbolic, const PressureSystem& g, double* values,
+int supernodal_numeric(const SupernodalSymbolic& symbolic, const SymmetricMatrix& g, double* values,
                        SupernodalWorkspace& work);
 
 }  // namespace pfv

@@ -5,8 +5,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pfv/model/pressure_system.hpp"
-
 namespace pfv {
 namespace {
 
@@ -49,9 +47,9 @@ std::vector<double> read_array(const std::string& path, int first, int count) {
 
 }  // namespace
 
-void write_system(const std::string& folder, const PressureSystem& s, const std::vector<double>& b,
+void write_system(const std::string& folder, const SymmetricMatrix& s, const std::vector<double>& b,
                   const std::vector<double>& x) {
-  const int n = s.n_unknowns();
+  const int n = s.size();
   if (static_cast<int>(b.size()) != n || static_cast<int>(x.size()) != n)
     throw std::invalid_argument("write_system needs one value of b and x per unknown");
   {

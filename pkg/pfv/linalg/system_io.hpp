@@ -7,15 +7,14 @@
 #include <string>
 #include <vector>
 
-#include "pfv/linalg/amg_pcg.hpp"
+#include "pfv/linalg/distributed_rows.hpp"
+#include "pfv/linalg/symmetric_matrix.hpp"
 
 namespace pfv {
 
-struct PressureSystem;
-
 // Throws std::runtime_error if a file cannot be written, std::invalid_argument if b or x do
 // not have one value per unknown.
-void write_system(const std::string& folder, const PressureSystem& system, const std::vector<double>& b,
+void write_system(const std::string& folder, const SymmetricMatrix& g, const std::vector<double>& b,
                   const std::vector<double>& x);
 
 // Rows first .. first + count - 1 of a saved system with the same rows of b and x.

@@ -94,7 +94,8 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
 
   // Upper triangle by column over unknowns.
   const int nu = s.n_unknowns();
-  s.col_start.assign(nu + 1, 0);
+  auto g = std::make_shared<SymmetricMatrix>();
+  g->col_start.assign(nu + 1, 0);
   for (int u = 0; u < nu; ++u) {
     const int c = s.unknown_cell[u];
     int count = 1;
@@ -102,14 +103,14 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
       const int v = s.unknown[s.adj_cell[e]];
       if (v >= 0 && v < u) ++count;
     }
-    s.col_start[u + 1] = s.col_start[u] + count;
+    g->col_start[u + 1] = g->col_start[u] + count;
   }
-  s.row.resize(s.col_start[nu]);
-  s.value.resize(s.col_start[nu]);
+  g->row.resize(g->col_start[nu]);
+  g->value.resize(g->col_start[nu]);
   std::vector<std::pair<int, double>> entries;
   for (int u = 0; u < nu; ++u) {
     const int c = s.unknown_cell[u];
-    int pos = s.col_start[u];
+    int pos = g->col_start[u];
     entries.clear();
     for (int e = s.adj_start[c]; e < s.adj_start[c + 1]; ++e) {
       const int v = s.unknown[s.adj_cell[e]];
@@ -117,45 +118,14 @@ PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& f
     }
     std::sort(entries.begin(), entries.end());
     for (const auto& [r, x] : entries) {
-      s.row[pos] = r;
-      s.value[pos++] = x;
+      g->row[pos] = r;
+      g->value[pos++] = x;
     }
-    s.row[pos] = u;
-    s.value[pos] = s.diagonal[c];
+    g->row[pos] = u;
+    g->value[pos] = s.diagonal[c];
   }
+  s.matrix = std::move(g);
   return s;
-}
-
-void index_rows(PressureSystem& s) {
-  const int nu = s.n_unknowns();
-  std::vector<int> count(nu, 0);
-  for (int j = 0; j < nu; ++j)
-    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e)
-      if (s.row[e] != j) {
-        ++count[j];
-        ++count[s.row[e]];
-      }
-  const int w = nu > 0 ? *std::max_element(count.begin(), count.end()) : 0;
-  s.row_width = w;
-  s.row_column.resize(static_cast<std::size_t>(nu) * w);
-  s.row_value.assign(static_cast<std::size_t>(nu) * w, 0.0);
-  s.row_diagonal.assign(nu, 0.0);
-  for (int u = 0; u < nu; ++u) std::fill_n(s.row_column.begin() + static_cast<std::size_t>(u) * w, w, u);
-  std::fill(count.begin(), count.end(), 0);
-  for (int j = 0; j < nu; ++j)
-    for (int e = s.col_start[j]; e < s.col_start[j + 1]; ++e) {
-      const int i = s.row[e];
-      if (i == j) {
-        s.row_diagonal[j] += s.value[e];
-        continue;
-      }
-      const std::size_t a = static_cast<std::size_t>(j) * w + count[j]++,
-                        b = static_cast<std::size_t>(i) * w + count[i]++;
-      s.row_column[a] = i;
-      s.row_value[a] = s.value[e];
-      s.row_column[b] = j;
-      s.row_value[b] = s.value[e];
-    }
 }
 
 void apply_dirichlet_values(const PressureSystem& s, const BoundaryConditions& bc, std::vector<double>& p) {

@@ -7,8 +7,10 @@
 // group of connected unknown cells reaches a Dirichlet cell; assembly checks this and names the
 // problem otherwise.
 #pragma once
+#include <memory>
 #include <vector>
 
+#include "pfv/linalg/symmetric_matrix.hpp"
 #include "pfv/model/boundary_conditions.hpp"
 #include "pfv/model/boundary_source.hpp"
 #include "pfv/model/cell_conditions.hpp"
@@ -27,18 +29,9 @@ struct PressureSystem {
   std::vector<double> adj_k;
   // Unknowns.
   std::vector<int> unknown_cell;
-  // Upper triangle of G over the unknowns, compressed by column (row <= column).
-  std::vector<int> col_start, row;
-  std::vector<double> value;
-  // The same G by rows in a fixed width (ELLPACK; index_rows() below), for the residual of
-  // every refinement pass: unknown u's off-diagonal entries in slots u * row_width .. (u + 1) *
-  // row_width - 1, padded with (u, 0). A pore cell has at most four neighbours, so the width
-  // is 4 on a tetrahedral mesh, and each residual entry is a gather of its row, where the
-  // upper triangle by column needs a scattered read-modify-write for the lower half.
-  // Empty unless index_rows() was called: only a refined solve needs them.
-  int row_width = 0;
-  std::vector<int> row_column;
-  std::vector<double> row_value, row_diagonal;
+  // G over the unknowns, unknown u's row and column u; shared with the solver set up for it
+  // (PressureSolver::setup), which keeps it for its solves.
+  std::shared_ptr<const SymmetricMatrix> matrix = std::make_shared<const SymmetricMatrix>();
 
   int n_unknowns() const { return static_cast<int>(unknown_cell.size()); }
 };
@@ -49,10 +42,6 @@ struct PressureSystem {
 PressureSystem assemble_pressure_system(const Mesh& mesh, const FacetGeometry& facets, const std::vector<double>& k,
                                         const BoundaryConditions& bc, const std::vector<int>& imposed_cells,
                                         const std::vector<double>& storage = {}, const CellConditions& cells = {});
-
-// Fills row_width, row_column, row_value and row_diagonal from col_start, row and value
-// (build_linear_system does it for a 32-bit factor, whose refinement reads them).
-void index_rows(PressureSystem& s);
 
 // Pressures of the Dirichlet cells of walls and imposed points from the current boundary values
 // (cheap; every step). Cells imposed on themselves and blocked cells keep their pressures.

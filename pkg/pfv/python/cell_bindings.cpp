@@ -223,10 +223,11 @@ void bind_cells(EngineClass& engine) {
            py::arg("radii"), "(volume per sphere, spheres whose power cell is incomplete): power_cells.hpp.")
       .def("system_matrix", exclusive([](const SharedEngine& e) {
              const PressureSystem& s = meshed(e).system();
+             const SymmetricMatrix& g = *s.matrix;
              py::dict d;
-             d["col_start"] = vector_to_array(s.col_start);
-             d["row"] = vector_to_array(s.row);
-             d["value"] = vector_to_array(s.value);
+             d["col_start"] = vector_to_array(g.col_start);
+             d["row"] = vector_to_array(g.row);
+             d["value"] = vector_to_array(g.value);
              d["unknown_cell"] = vector_to_array(s.unknown_cell);
              return d;
            }),

@@ -65,7 +65,7 @@ void bind_output(EngineClass& engine) {
                  m.last_solution().size() != m.last_rhs().size())
                throw py::value_error("no solve on the current system yet (run a step first)");
              try {
-               write_system(folder, m.system(), m.last_rhs(), m.last_solution());
+               write_system(folder, *m.system().matrix, m.last_rhs(), m.last_solution());
              } catch (const std::runtime_error& error) {
                throw py::value_error(error.what());
              }

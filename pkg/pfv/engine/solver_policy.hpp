@@ -1,0 +1,64 @@
+// The solver policy: which pressure solver a linear system gets, and what a remesh carries to
+// the next one. Every rule of solver = auto lives here:
+//  - choose: the Cholesky factor when it fits its budget (max_factor_bytes, else half the
+//    memory available) and CHOLMOD's 32-bit index range, else multigrid; the analysis that
+//    measures the factor is all a refused factor costs;
+//  - keep: a multigrid solver chosen for the last mesh stays chosen for the next (a mesh of a
+//    like size) until the budget changes, without the ordering and analysis that would only
+//    confirm it; a background remesh gets an empty multigrid solver standing for it;
+//  - recycle: a remesh hands the released solver (with the storage of its factor's values) to
+//    the next system, so that peak memory is one factor and no new pages are faulted.
+// A named solver is taken as asked (a named Cholesky refuses a factor beyond its bound with an
+// error). Multigrid exists only in a build with hypre (PFV_WITH_HYPRE); without it asking for
+// it is an error and auto never takes it.
+#pragma once
+#include <memory>
+#include <string>
+
+#include "pfv/common/stage_timer.hpp"
+#include "pfv/engine/engine_settings.hpp"
+#include "pfv/linalg/pressure_solver.hpp"
+#include "pfv/linalg/symmetric_matrix.hpp"
+
+namespace pfv {
+
+struct LinearSystem;
+
+// Empty if this build has the solver, else why not (an unknown kind, or multigrid without hypre).
+std::string solver_unavailable(SolverKind kind);
+
+// Whether a system built for 'solver' must be rebuilt when the multigrid smoother changes (under
+// kAuto also while it keeps the factor: the recipe does not know the choice).
+bool reads_multigrid_smoother(SolverKind solver);
+
+// The solver of a new system before its setup: the recycled one if it is of the kind the
+// settings ask for (under kAuto, a Cholesky solver or a multigrid one kept), else a new one.
+struct SolverPlan {
+  std::unique_ptr<PressureSolver> solver;
+  bool automatic = false;  // settings.solver is kAuto
+  double budget = 0;       // factor values allowed (Cholesky and kAuto); infinity: no bound known
+};
+SolverPlan plan_solver(const EngineSettings& settings, std::unique_ptr<PressureSolver> recycled);
+
+// The options of every solver from the settings; the factor's given ordering is the caller's.
+SolverOptions solver_options(const EngineSettings& settings, const SolverPlan& plan);
+
+// Sets plan.solver up for g (at least one unknown) and returns it, with the reason for the
+// choice in 'choice' ("multigrid: the Cholesky factor would store ...") and, for a refused
+// factor, the seconds from 'start' to the refusal in 'analysis'. Throws what the solver's setup
+// throws, and std::runtime_error if a Cholesky factor exceeds its bound with no fallback.
+std::unique_ptr<PressureSolver> set_up_solver(SolverPlan plan, std::shared_ptr<const SymmetricMatrix> g,
+                                              const SolverOptions& options, const EngineSettings& settings,
+                                              StageClock::time_point start, std::string& choice, double& analysis);
+
+// Under kAuto: multigrid was chosen for 'current' and the bound it was chosen against is
+// unchanged, so the next system keeps it without an analysis.
+bool auto_keeps_multigrid(const EngineSettings& settings, const LinearSystem& current);
+// The current system's solver with what it built freed, for the next build (null if there is
+// none, or if kAuto must choose again).
+std::unique_ptr<PressureSolver> release_solver(const EngineSettings& settings, LinearSystem& current);
+// What a background remesh, which cannot take the solver in use, passes to its build: an empty
+// multigrid solver standing for it where kAuto keeps that choice (else null).
+std::unique_ptr<PressureSolver> background_stand_in(bool keeps_multigrid);
+
+}  // namespace pfv

@@ -32,7 +32,7 @@ test::TestPacking cubic8() {
 }
 
 // The cubic 8 and a centre sphere of diameter ratio d/D, every radius shrunk by 1 % (the FEM
-// comparison's packing, bench/stokes/packings.py).
+// comparison's packing, validation/stokes/packings.py).
 test::TestPacking centred9(double d_over_D) {
   test::TestPacking p = cubic8();
   p.centre.emplace_back(0.5, 0.5, 0.5);

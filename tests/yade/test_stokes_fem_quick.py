@@ -2,9 +2,9 @@
 
     yade-double -n -x tests/yade/test_stokes_fem_quick.py      (exit 0 = pass)
 
-Runs ``bench/stokes/run.py --quick`` with Debian's /usr/bin/python3 (dolfinx 0.5.2 and gmsh, which
-scripts/setup installs; the script fails, it does not skip, when they are missing) against the
-pfv package of PYTHONPATH, and compares with tests/data/stokes_fem_quick.json, which
+Runs ``python3 -m validation.stokes.run --quick`` from the repository's root with Debian's /usr/bin/python3
+(dolfinx 0.5.2 and gmsh, which scripts/setup installs; the script fails, it does not skip, when they are missing)
+against the pfv package of PYTHONPATH, and compares with tests/data/stokes_fem_quick.json, which
 ``run.py --quick --write-reference`` regenerates: the FEM permeability with symmetry and with
 no-slip lateral faces to 1e-6, the FEM flux balance (1e-4) and the share of folded curved cells
 (0.1 %), MINRES against the direct solve (1e-8), and PFV's permeability for the three wall variants.
@@ -15,8 +15,8 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].endswith('.py') else __file__))
-RUN = os.path.join(HERE, '..', '..', 'bench', 'stokes', 'run.py')
+ROOT = os.path.join(HERE, '..', '..')
 
 env = dict(os.environ, OMP_NUM_THREADS='1', OPENBLAS_NUM_THREADS='1')
-done = subprocess.run(['/usr/bin/python3', RUN, '--quick'], env=env)
+done = subprocess.run(['/usr/bin/python3', '-m', 'validation.stokes.run', '--quick'], env=env, cwd=ROOT)
 sys.exit(1 if done.returncode else 0)

@@ -1,14 +1,17 @@
 """Stokes (FEM) against PFV and YADE on the thesis' frozen packings (section 3.5): the driver.
 
-    /usr/bin/python3 bench/stokes/run.py [--cases=a,b] [--levels=0.048,0.034,0.024] [--out=FILE]
-    /usr/bin/python3 bench/stokes/run.py --quick [--write-reference]
-    /usr/bin/python3 bench/stokes/run.py --models-only --cases=cubic8@0,random25@0 --out=FILE
+From the repository's root:
+
+    /usr/bin/python3 -m validation.stokes.run [--cases=a,b] [--levels=0.048,0.034,0.024] [--out=FILE]
+    /usr/bin/python3 -m validation.stokes.run --quick [--write-reference]
+    /usr/bin/python3 -m validation.stokes.run --models-only --cases=cubic8@0,random25@0 --out=FILE
 
 Needs the pfv package on PYTHONPATH (a build tree's python/ folder) and, for the YADE column,
 yade-double on PATH. For every case and every sphere-surface element size of --levels (mesh.py)
 it solves Stokes flow with symmetry and with no-slip lateral faces (solve.py), then runs PFV
 (no-slip walls, slip walls with the thesis' formula, slip walls with YADE's factor;
-pfv_model.py) and YADE's engine (yade_model.py) on the same spheres. Results are appended case by case to --out (JSON).
+pfv_model.py) and YADE's engine (yade_model.py) on the same spheres. Results are appended case by case to --out (JSON,
+by default in validation/stokes/results/, which is not tracked: report.py reads them from there).
 
 --quick runs the CI case: the 8-sphere packing on one coarse mesh, solved directly and (symmetry faces)
 by MINRES; with --write-reference it writes tests/data/stokes_fem_quick.json, else it compares with
@@ -28,13 +31,10 @@ import time
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
+from . import mesh as fem_mesh
+from . import packings, pfv_model, solve
 
-import mesh as fem_mesh  # noqa: E402
-import packings  # noqa: E402
-import pfv_model  # noqa: E402
-import solve  # noqa: E402
+HERE = os.path.dirname(os.path.abspath(__file__))
 
 ROOT = os.path.dirname(os.path.dirname(HERE))
 REFERENCE = os.path.join(ROOT, "tests", "data", "stokes_fem_quick.json")
@@ -44,7 +44,7 @@ D_OVER_D = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.72, 0.8)
 
 
 def case_packing(name):
-    """The shrunk packing of a case: cubic8, centred9_<d/D>, random<N> (bench/stokes/data), each
+    """The shrunk packing of a case: cubic8, centred9_<d/D>, random<N> (validation/stokes/data), each
     optionally with @<shrink> (default SHRINK)."""
     base, _, shrink = name.partition("@")
     if base == "cubic8":

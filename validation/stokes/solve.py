@@ -26,7 +26,7 @@ from dolfinx.mesh import meshtags
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from mesh import FACES, SPHERE_TAG
+from .mesh import FACES, SPHERE_TAG
 
 LATERAL = (1, 2, 5, 6)  # xmin, xmax, zmin, zmax: the flow is along y
 INLET, OUTLET = 3, 4
@@ -40,30 +40,14 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_toler
     W = fem.FunctionSpace(mesh, element)
     fdim = mesh.topology.dim - 1
     mesh.topology.create_connectivity(fdim, mesh.topology.dim)
-
-    def marked(markers):
-        return np.concatenate([facets.find(m) for m in markers]).astype(np.int32)
-
     V, _ = W.sub(0).collapse()
-    zero = fem.Function(V)
-    walls = [SPHERE_TAG + k for k in range(n_spheres)]
-    if lateral == "noslip":
-        walls += list(LATERAL)
-    bcs = [fem.dirichletbc(zero, fem.locate_dofs_topological((W.sub(0), V), fdim, marked(walls)), W.sub(0))]
-    if lateral == "symmetry":
-        for axis, markers in ((0, (1, 2)), (2, (5, 6))):
-            sub = W.sub(0).sub(axis)
-            dofs = fem.locate_dofs_topological(sub, fdim, marked(markers))
-            bcs.append(fem.dirichletbc(PETSc.ScalarType(0), dofs, sub))
-    elif lateral != "noslip":
-        raise ValueError("lateral must be 'symmetry' or 'noslip'")
+    bcs = boundary_conditions(W, V, facets, n_spheres, lateral)
 
     u, p = ufl.TrialFunctions(W)
     v, q = ufl.TestFunctions(W)
     ds = ufl.Measure("ds", domain=mesh, subdomain_data=facets)
     n = ufl.FacetNormal(mesh)
-    eps = ufl.sym
-    a = (2 * mu * ufl.inner(eps(ufl.grad(u)), eps(ufl.grad(v))) - p * ufl.div(v) - q * ufl.div(u)) * ufl.dx
+    a = (2 * mu * ufl.inner(ufl.sym(ufl.grad(u)), ufl.sym(ufl.grad(v))) - p * ufl.div(v) - q * ufl.div(u)) * ufl.dx
     L = -dp * ufl.inner(n, v) * ds(INLET)
 
     A = fem.petsc.assemble_matrix(fem.form(a), bcs=bcs)
@@ -100,28 +84,7 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_toler
     # Every section y = const carries the same flux in the exact solution; the volume integral of
     # u_y (l0 = 1) is their mean, reported beside the two face fluxes as a check.
     flux_mean = integral(uh[1] * ufl.dx)
-    # force of the fluid on the solid: -sigma.n with n the outward normal of the fluid. One
-    # marker at a time is tagged 1 in its own MeshTags, so the forms compile once.
-    e = fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
-    dsk = ufl.Measure("ds", domain=mesh, subdomain_data=facets)
-
-    def part_forms(measure):
-        return (fem.form(ph * ufl.dot(n, e) * measure(1)),
-                fem.form(-2 * mu * ufl.dot(ufl.dot(eps(ufl.grad(uh)), n), e) * measure(1)))
-
-    forces = {}
-    for marker, name in [(SPHERE_TAG + k, "sphere%d" % k) for k in range(n_spheres)] + \
-            [(m, FACES[m - 1]) for m in LATERAL]:
-        tags = meshtags(mesh, fdim, np.sort(facets.find(marker)).astype(np.int32),
-                        np.ones(len(facets.find(marker)), dtype=np.int32))
-        dsk = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
-        forms = part_forms(dsk)
-        parts = {"pressure": [], "viscous": []}
-        for i in range(3):
-            e.value = np.eye(3)[i]
-            for key, form in zip(("pressure", "viscous"), forms):
-                parts[key].append(mesh.comm.allreduce(fem.assemble_scalar(form), op=MPI.SUM))
-        forces[name] = parts
+    forces = solid_forces(mesh, facets, n_spheres, uh, ph, mu)
     for obj in (ksp, A, b) + ((preconditioner,) if preconditioner is not None else ()):
         obj.destroy()
     return {
@@ -137,6 +100,56 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_toler
         "iterations": iterations,
         "forces": forces,
     }
+
+
+def boundary_conditions(W, V, facets, n_spheres, lateral):
+    """No-slip on the spheres (and, with lateral="noslip", on the four lateral faces); with
+    lateral="symmetry" only the normal velocity vanishes on the lateral faces."""
+    fdim = W.mesh.topology.dim - 1
+
+    def marked(markers):
+        return np.concatenate([facets.find(m) for m in markers]).astype(np.int32)
+
+    zero = fem.Function(V)
+    walls = [SPHERE_TAG + k for k in range(n_spheres)]
+    if lateral == "noslip":
+        walls += list(LATERAL)
+    bcs = [fem.dirichletbc(zero, fem.locate_dofs_topological((W.sub(0), V), fdim, marked(walls)), W.sub(0))]
+    if lateral == "symmetry":
+        for axis, markers in ((0, (1, 2)), (2, (5, 6))):
+            sub = W.sub(0).sub(axis)
+            dofs = fem.locate_dofs_topological(sub, fdim, marked(markers))
+            bcs.append(fem.dirichletbc(PETSc.ScalarType(0), dofs, sub))
+    elif lateral != "noslip":
+        raise ValueError("lateral must be 'symmetry' or 'noslip'")
+    return bcs
+
+
+def solid_forces(mesh, facets, n_spheres, uh, ph, mu):
+    """The force of the fluid on every sphere and lateral face, -sigma.n with n the outward normal
+    of the fluid, split into its pressure and viscous parts. One marker at a time is tagged 1 in
+    its own MeshTags, so the forms compile once."""
+    fdim = mesh.topology.dim - 1
+    n = ufl.FacetNormal(mesh)
+    e = fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
+
+    def part_forms(measure):
+        return (fem.form(ph * ufl.dot(n, e) * measure(1)),
+                fem.form(-2 * mu * ufl.dot(ufl.dot(ufl.sym(ufl.grad(uh)), n), e) * measure(1)))
+
+    forces = {}
+    for marker, name in [(SPHERE_TAG + k, "sphere%d" % k) for k in range(n_spheres)] + \
+            [(m, FACES[m - 1]) for m in LATERAL]:
+        tags = meshtags(mesh, fdim, np.sort(facets.find(marker)).astype(np.int32),
+                        np.ones(len(facets.find(marker)), dtype=np.int32))
+        forms = part_forms(ufl.Measure("ds", domain=mesh, subdomain_data=tags))
+        parts = {"pressure": [], "viscous": []}
+        for i in range(3):
+            e.value = np.eye(3)[i]
+            for key, form in zip(("pressure", "viscous"), forms):
+                parts[key].append(mesh.comm.allreduce(fem.assemble_scalar(form), op=MPI.SUM))
+        forces[name] = parts
+    return forces
 
 
 def direct_solver(A, blr_tolerance, symmetric):

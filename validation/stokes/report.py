@@ -1,6 +1,6 @@
 """Tables and figure of the Stokes comparison from run.py's JSON (doc/validation.md section 7).
 
-    /usr/bin/python3 bench/stokes/report.py [--results=FILE] [--figure=doc/figures/stokes-kappa.png]
+    /usr/bin/python3 -m validation.stokes.report [--results=FILE] [--figure=doc/figures/stokes-kappa.png]
 
 Prints Markdown: the mesh-convergence table of every case, the permeability table (FEM at the
 finest mesh, its Richardson estimate, PFV's three wall variants and YADE's engine, with the

@@ -1,6 +1,6 @@
 """YADE's own FlowEngine on a frozen packing: run by yade-double, not imported.
 
-    yade-double -n -x bench/stokes/yade_model.py PACKING.json OUT.json
+    yade-double -n -x validation/stokes/yade_model.py PACKING.json OUT.json
 
 The unit cube as six aabbWalls, the spheres fixed, pressure dp = 1 on ymin and 0 on ymax, mu = 1,
 the engine's defaults otherwise; one step for slipBoundary False and one for True. Writes

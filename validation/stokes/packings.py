@@ -106,8 +106,8 @@ def load(path):
 
 
 if __name__ == "__main__":
-    # python3 packings.py N RATIO SEED data/NAME.json: a random packing for run.py's case NAME
-    # (random<N>, or random<N>s<SEED> for further seeds)
+    # python3 -m validation.stokes.packings N RATIO SEED validation/stokes/data/NAME.json (from the repository's
+    # root): a random packing for run.py's case NAME (random<N>, or random<N>s<SEED> for further seeds)
     import os
     import sys
     n, ratio, seed, path = int(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]

@@ -1,0 +1,5 @@
+"""Stokes flow by finite elements against PFV and YADE on the thesis' frozen packings (doc/validation.md section 7).
+
+``run`` drives the comparison and writes JSON into ``results/`` (not tracked), ``report`` prints its tables;
+``packings``, ``mesh``, ``solve``, ``pfv_model`` and ``yade_model`` hold one part each.
+"""

@@ -23,17 +23,12 @@ import statistics
 import subprocess
 import sys
 
-
-def option(argv, name, default):
-    for a in argv:
-        if a.startswith("--" + name + "="):
-            return a.split("=", 1)[1]
-    return default
+from pfv_testing.cli import option
 
 
 def lattice_child(argv):
     import time
-    from core_steady import lattice_permeameter
+    from pfv_testing.lattice import lattice_permeameter
 
     e, pos, rad, walls = lattice_permeameter(int(float(option(argv, "size", "10000"))))
     e.solver = option(argv, "solver", "auto")
@@ -61,10 +56,9 @@ def lattice_child(argv):
 
 
 def child(argv):
-    sys.path.insert(0, os.path.dirname(os.path.abspath(argv[0])))
     if option(argv, "scene", "permeameter") == "lattice":
         return lattice_child(argv)
-    import flow_benchmark as fb
+    from pfv_testing.flow_bench import scene as fb
     from yade import O
 
     n = int(option(argv, "size", "10000"))

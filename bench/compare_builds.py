@@ -30,16 +30,14 @@ SHARED = os.path.dirname(os.path.dirname(os.path.abspath(pfv_testing.__file__)))
 
 
 def lattice_child(argv):
-    import time
     from pfv_testing.lattice import lattice_permeameter
+    from pfv_testing.timing import wall
 
     e, pos, rad, walls = lattice_permeameter(int(float(option(argv, "size", "10000"))))
     e.solver = option(argv, "solver", "auto")
 
     def timed_step():
-        t0 = time.perf_counter()
-        e.step(pos, rad, walls, 1e-4)
-        return time.perf_counter() - t0
+        return wall(lambda: e.step(pos, rad, walls, 1e-4))
 
     for _ in range(4):  # the first step and three settling steps
         timed_step()

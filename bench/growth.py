@@ -42,6 +42,7 @@ import time
 from pfv_testing import paths
 from pfv_testing.lattice_scene import build_scene, insert, make_flow, remove_flows
 from pfv_testing.memory import reset_peak, rss_kb
+from pfv_testing.timing import yade_step as timed_step
 
 
 REPO = paths.REPO
@@ -75,13 +76,6 @@ def options(argv):
 
 
 # ------------------------------------------------------------------------------------------------ children (in yade)
-def timed_step():
-    from yade import O
-    t0 = time.perf_counter()
-    O.step()
-    return time.perf_counter() - t0
-
-
 def dry_block(flow):
     """BLOCK dry steps: `flow` taken out of O.engines for them, then put back."""
     remove_flows()
@@ -205,12 +199,10 @@ def fit_exponent(ns, ys):
     return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx if sxx > 0 else None
 
 
-def report(data, command):
-    rows = summarise(data["timing"], data["memory"])
-    L = [f"Produced by `{command}` (one thread per process; per trial {data['blocks']} blocks of {BLOCK} coupled "
-         f"steps, each between blocks of {BLOCK} dry steps).", ""]
-    L.append("| N | engine | first step [s] | remesh [s] | flow step [ms] | dry DEM step [ms] | "
-             "coupled / dry (blocks) | peak RSS [MB] | PFV's solver |")
+def _cost_table(rows):
+    """Each engine's costs at each N."""
+    L = ["| N | engine | first step [s] | remesh [s] | flow step [ms] | dry DEM step [ms] | "
+         "coupled / dry (blocks) | peak RSS [MB] | PFV's solver |"]
     L.append("|---|---|---|---|---|---|---|---|---|")
     for r in sorted(rows, key=lambda r: (r["n"], KINDS.index(r["kind"]))):
         peak = f"{r['peak_mb']:.0f}" if r["peak_mb"] is not None else "–"
@@ -222,6 +214,11 @@ def report(data, command):
                  f"{1e3 * r['dry']:.1f} | {r['coupled_over_dry']:.2f} ({r['ratio_range'][0]:.2f}–"
                  f"{r['ratio_range'][1]:.2f}) | {peak} | {choice} |")
     L.append("")
+    return L
+
+
+def _ratio_table(rows):
+    """PFV's costs over YADE's where both ran."""
     by = {(r["n"], r["kind"]): r for r in rows}
     ratios = []
     for n in sorted({r["n"] for r in rows}):
@@ -234,9 +231,14 @@ def report(data, command):
                 mem = (f"{p['peak_mb'] / y['peak_mb']:.2f}" if p["peak_mb"] and y["peak_mb"] else "–")
                 ratios.append(f"| {size(n)} | {kind} | {p['first'] / y['first']:.2f} | "
                               f"{p['remesh'] / y['remesh']:.2f} | {p['flow'] / y['flow']:.2f} | {mem} |")
-    if ratios:
-        L += ["PFV / YADE:", "", "| N | PFV | first step | remesh | flow step | peak RSS |",
-              "|---|---|---|---|---|---|"] + ratios + [""]
+    if not ratios:
+        return []
+    return ["PFV / YADE:", "", "| N | PFV | first step | remesh | flow step | peak RSS |",
+            "|---|---|---|---|---|---|"] + ratios + [""]
+
+
+def _exponent_table(rows):
+    """The fitted exponents of each engine's costs."""
     fits = []
     for kind in KINDS:
         rs = sorted([r for r in rows if r["kind"] == kind], key=lambda r: r["n"])
@@ -246,21 +248,35 @@ def report(data, command):
         e = {q: fit_exponent(ns, [r[q] for r in rs]) for q in ("first", "remesh", "flow", "peak_mb")}
         fits.append(f"| {kind} | {size(ns[0])}–{size(ns[-1])} | " + " | ".join(
             f"{e[q]:.2f}" if e[q] is not None else "–" for q in ("first", "remesh", "flow", "peak_mb")) + " |")
-    if fits:
-        L += ["Fitted exponents a of cost ∝ N^a (least squares on log–log over the sizes measured):", "",
-              "| engine | N | first step | remesh | flow step | peak RSS |", "|---|---|---|---|---|---|"] + fits + [""]
+    if not fits:
+        return []
+    return ["Fitted exponents a of cost ∝ N^a (least squares on log–log over the sizes measured):", "",
+            "| engine | N | first step | remesh | flow step | peak RSS |", "|---|---|---|---|---|---|"] + fits + [""]
+
+
+def _stage_table(data):
+    """PFV's forced remesh by stage."""
     stages = [(t["n"], kind, tr["remesh_times"]) for t in data["timing"] if not t.get("failed")
               for kind, tr in t["trials"].items() if "remesh_times" in tr]
-    if stages:
-        keys = ("triangulation", "geometry", "conductance", "force_cache", "assembly", "analysis", "factorization",
-                "carry_over")
-        L += ["PFV's forced remesh by stage (`remesh_times()` after the remesh window) [s]; the rest of the window is "
-              "the first solves on the new mesh, the time-step guard and the exchange with YADE:", "",
-              "| N | engine | " + " | ".join(k.replace("_", " ") for k in keys) + " |",
-              "|---|---|" + "---|" * len(keys)]
-        for n, kind, st in sorted(stages, key=lambda x: (x[0], KINDS.index(x[1]))):
-            L.append(f"| {size(n)} | {kind} | " + " | ".join(f"{st.get(k, 0.0):.2f}" for k in keys) + " |")
-        L.append("")
+    if not stages:
+        return []
+    keys = ("triangulation", "geometry", "conductance", "force_cache", "assembly", "analysis", "factorization",
+            "carry_over")
+    L = ["PFV's forced remesh by stage (`remesh_times()` after the remesh window) [s]; the rest of the window is "
+         "the first solves on the new mesh, the time-step guard and the exchange with YADE:", "",
+         "| N | engine | " + " | ".join(k.replace("_", " ") for k in keys) + " |",
+         "|---|---|" + "---|" * len(keys)]
+    for n, kind, st in sorted(stages, key=lambda x: (x[0], KINDS.index(x[1]))):
+        L.append(f"| {size(n)} | {kind} | " + " | ".join(f"{st.get(k, 0.0):.2f}" for k in keys) + " |")
+    L.append("")
+    return L
+
+
+def report(data, command):
+    rows = summarise(data["timing"], data["memory"])
+    L = [f"Produced by `{command}` (one thread per process; per trial {data['blocks']} blocks of {BLOCK} coupled "
+         f"steps, each between blocks of {BLOCK} dry steps).", ""]
+    L += _cost_table(rows) + _ratio_table(rows) + _exponent_table(rows) + _stage_table(data)
     failed = [c for c in data["timing"] + data["memory"] if c.get("failed")]
     for c in failed:
         L.append(f"Child `{' '.join(c['args'])}` failed (exit {c['returncode']}): `{c['tail'].splitlines()[-1][:200]}`")

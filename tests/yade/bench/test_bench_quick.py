@@ -38,6 +38,60 @@ def _positive(x):
     return isinstance(x, (int, float)) and math.isfinite(x) and x > 0
 
 
+def _check_report(out, check):
+    """The Markdown report: between its markers, a timing table with a row of times for both engines."""
+    md = open(out).read() if os.path.exists(out) else ''
+    check('flow_benchmark output' in md, 'report written between markers')
+    lines = md.splitlines()
+    head = next((i for i, line in enumerate(lines) if 'remesh YADE' in line and 'remesh PFV' in line), None)
+    check(head is not None, 'timing table has YADE and PFV columns')
+    rows = []
+    if head is not None:
+        for line in lines[head + 2:]:
+            if not line.startswith('|'):
+                break
+            rows.append(line)
+    rows = [line for line in rows if line.startswith('| %d |' % QUICK_SIZE)]
+    check(len(rows) >= 1, 'timing table has a row for N=%d' % QUICK_SIZE)
+    if rows:
+        cells = [c.strip() for c in rows[0].strip('|').split('|')]
+        check(sum(1 for c in cells if c.endswith(' ms') or c.endswith(' s')) >= 6, 'row has times for both engines')
+
+
+def _check_timings(row, check):
+    """The summary's times, cells, PFV breakdown and pressure comparison at the quick size."""
+    for kind in ('yade', 'pfv'):
+        e = row.get(kind, {})
+        for what in ('remesh', 'flow', 'coupled', 'first'):
+            check(_positive(e.get(what)), '%s %s time positive and finite' % (kind, what))
+        check(isinstance(e.get('cells'), int) and e['cells'] > 0, '%s reports a number of cells' % kind)
+    check(_positive(row.get('dry')), 'dry step time positive and finite')
+    br = row.get('pfv_breakdown', {})
+    for stage in ('triangulation', 'geometry', 'factorization', 'force_cache'):
+        check(_positive(br.get('remesh', {}).get(stage)), 'PFV remesh breakdown has %s' % stage)
+    for stage in ('solve', 'python + exchange'):
+        check(stage in br.get('steady', {}), 'PFV steady breakdown has %s' % stage)
+    a = row.get('agreement', {})
+    check(isinstance(a.get('max_dp'), float) and math.isfinite(a['max_dp']), 'pressure comparison computed')
+    print('  (info) probe pressures: max |dp|/dp = %s, Qin rel. diff = %s'
+          % (a.get('max_dp'), a.get('flux_in_rel')))
+
+
+def _check_json(js, check):
+    """The raw data: timings, memory and the oedometer."""
+    data = json.load(open(js)) if os.path.exists(js) else {}
+    summ = data.get('summary', {})
+    t = next(iter(summ.values()), {})
+    _check_timings(t.get('sizes', {}).get(str(QUICK_SIZE), {}), check)
+    mem = data.get('memory', {}).get(str(QUICK_SIZE), {})
+    for kind in ('dry', 'yade', 'pfv'):
+        m = mem.get(kind, {})
+        check(_positive(m.get('peak_kb')) and _positive(m.get('rss_before_kb')), 'memory figures for %s' % kind)
+    oe = next(iter(t.get('oedometer', {}).values()), {})
+    for kind in ('yade', 'pfv'):
+        check(_positive(oe.get(kind, {}).get('ratio')), 'oedometer coupled/dry ratio for %s' % kind)
+
+
 def main():
     exe = shutil.which('yade-double') or 'yade-double'
     failures = []
@@ -57,48 +111,8 @@ def main():
         if r.returncode != 0:
             print(r.stdout[-4000:], r.stderr[-2000:])
             return 1
-        md = open(out).read() if os.path.exists(out) else ''
-        check('flow_benchmark output' in md, 'report written between markers')
-        lines = md.splitlines()
-        head = next((i for i, line in enumerate(lines) if 'remesh YADE' in line and 'remesh PFV' in line), None)
-        check(head is not None, 'timing table has YADE and PFV columns')
-        rows = []
-        if head is not None:
-            for line in lines[head + 2:]:
-                if not line.startswith('|'):
-                    break
-                rows.append(line)
-        rows = [line for line in rows if line.startswith('| %d |' % QUICK_SIZE)]
-        check(len(rows) >= 1, 'timing table has a row for N=%d' % QUICK_SIZE)
-        if rows:
-            cells = [c.strip() for c in rows[0].strip('|').split('|')]
-            check(sum(1 for c in cells if c.endswith(' ms') or c.endswith(' s')) >= 6, 'row has times for both engines')
-        data = json.load(open(js)) if os.path.exists(js) else {}
-        summ = data.get('summary', {})
-        t = next(iter(summ.values()), {})
-        row = t.get('sizes', {}).get(str(QUICK_SIZE), {})
-        for kind in ('yade', 'pfv'):
-            e = row.get(kind, {})
-            for what in ('remesh', 'flow', 'coupled', 'first'):
-                check(_positive(e.get(what)), '%s %s time positive and finite' % (kind, what))
-            check(isinstance(e.get('cells'), int) and e['cells'] > 0, '%s reports a number of cells' % kind)
-        check(_positive(row.get('dry')), 'dry step time positive and finite')
-        br = row.get('pfv_breakdown', {})
-        for stage in ('triangulation', 'geometry', 'factorization', 'force_cache'):
-            check(_positive(br.get('remesh', {}).get(stage)), 'PFV remesh breakdown has %s' % stage)
-        for stage in ('solve', 'python + exchange'):
-            check(stage in br.get('steady', {}), 'PFV steady breakdown has %s' % stage)
-        a = row.get('agreement', {})
-        check(isinstance(a.get('max_dp'), float) and math.isfinite(a['max_dp']), 'pressure comparison computed')
-        print('  (info) probe pressures: max |dp|/dp = %s, Qin rel. diff = %s'
-              % (a.get('max_dp'), a.get('flux_in_rel')))
-        mem = data.get('memory', {}).get(str(QUICK_SIZE), {})
-        for kind in ('dry', 'yade', 'pfv'):
-            m = mem.get(kind, {})
-            check(_positive(m.get('peak_kb')) and _positive(m.get('rss_before_kb')), 'memory figures for %s' % kind)
-        oe = next(iter(t.get('oedometer', {}).values()), {})
-        for kind in ('yade', 'pfv'):
-            check(_positive(oe.get(kind, {}).get('ratio')), 'oedometer coupled/dry ratio for %s' % kind)
+        _check_report(out, check)
+        _check_json(js, check)
     print('\n%d failed' % len(failures))
     return 1 if failures else 0
 

@@ -1,6 +1,7 @@
 """Side-by-side benchmark of YADE's FlowEngine and PFV's FlowEngine.
 
-Run with YADE (the driver re-invokes yade-double on this file for every measurement):
+Run with YADE from the repository root with PYTHONPATH=build/python (the parts of this benchmark are in
+pfv_testing.flow_bench; the driver re-invokes yade-double on this file for every measurement):
 
     yade-double -n -x bench/flow_benchmark.py [--quick] [--sizes=1000,10000,50000] [--rounds=3]
                 [--threads=1,2] [--out=doc/benchmarks.md] [--json=FILE] [--no-memory] [--no-oedometer]

@@ -1,6 +1,6 @@
 """The installed package is importable from any directory by yade-double (no PYTHONPATH).
 
-CTest runs every tests/yade/test_*.py with PYTHONPATH pointing at the build tree; this one
+CTest runs every tests/yade/<group>/test_*.py with PYTHONPATH pointing at the build tree; this one
 re-runs a tiny script from a temporary directory with a clean environment instead.
 """
 import os

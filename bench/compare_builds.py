@@ -3,19 +3,19 @@ must not alter speed (a refactoring), or one meant to change it, run the build b
 build after; the children alternate between the builds round after round, so that drift of the
 machine falls on both.
 
-    python3 bench/compare_builds.py --builds=OLD_PYTHONPATH,NEW_PYTHONPATH [--size=10000] [--rounds=3]
-                                    [--steady=20] [--remeshes=2] [--threads=1]
-                                    [--scene=permeameter|lattice] [--solver=auto]
+    PYTHONPATH=build/python python3 bench/compare_builds.py --builds=OLD_PYTHONPATH,NEW_PYTHONPATH
+        [--size=10000] [--rounds=3] [--steady=20] [--remeshes=2] [--threads=1]
+        [--scene=permeameter|lattice] [--solver=auto]
 
 --scene=permeameter (default): the benchmark permeameter in YADE (the cached dense packing of
 bench/flow_benchmark.py, dynamic spheres, CHOLMOD, settled), times as the engine's execTime in
 the DEM loop. --scene=lattice: the C++ engine alone (pfv.Engine, no YADE) on bench/growth.py's
-jittered lattice with fixed spheres (bench/core_steady.py), with --solver (auto, cholesky,
+jittered lattice with fixed spheres (pfv_testing.lattice), with --solver (auto, cholesky,
 multigrid); times are the step's wall time, and the solve's is reported beside it.
 
-Each PYTHONPATH holds a `pfv` package (e.g. build/python). Prints per build the median over
-rounds of the per-round medians, and the ratio of the second build to the first. No timing is
-asserted anywhere.
+Each PYTHONPATH holds a `pfv` package (e.g. build/python); the children find pfv_testing where the
+driver did. Prints per build the median over rounds of the per-round medians, and the ratio of
+the second build to the first. No timing is asserted anywhere.
 """
 import json
 import os
@@ -23,25 +23,21 @@ import statistics
 import subprocess
 import sys
 
+import pfv_testing
+from pfv_testing.cli import option
 
-def option(argv, name, default):
-    for a in argv:
-        if a.startswith("--" + name + "="):
-            return a.split("=", 1)[1]
-    return default
+SHARED = os.path.dirname(os.path.dirname(os.path.abspath(pfv_testing.__file__)))
 
 
 def lattice_child(argv):
-    import time
-    from core_steady import lattice_permeameter
+    from pfv_testing.lattice import lattice_permeameter
+    from pfv_testing.timing import wall
 
     e, pos, rad, walls = lattice_permeameter(int(float(option(argv, "size", "10000"))))
     e.solver = option(argv, "solver", "auto")
 
     def timed_step():
-        t0 = time.perf_counter()
-        e.step(pos, rad, walls, 1e-4)
-        return time.perf_counter() - t0
+        return wall(lambda: e.step(pos, rad, walls, 1e-4))
 
     for _ in range(4):  # the first step and three settling steps
         timed_step()
@@ -61,10 +57,9 @@ def lattice_child(argv):
 
 
 def child(argv):
-    sys.path.insert(0, os.path.dirname(os.path.abspath(argv[0])))
     if option(argv, "scene", "permeameter") == "lattice":
         return lattice_child(argv)
-    import flow_benchmark as fb
+    from pfv_testing.flow_bench import scene as fb
     from yade import O
 
     n = int(option(argv, "size", "10000"))
@@ -107,7 +102,9 @@ def driver(argv):
     results = {b: [] for b in builds}
     for r in range(rounds):
         for b in (builds if r % 2 == 0 else builds[::-1]):
-            env = dict(os.environ, PYTHONPATH=b, OMP_NUM_THREADS=threads, OPENBLAS_NUM_THREADS=threads)
+            # The build's pfv first; pfv_testing from where this driver found it (an old build may lack it).
+            env = dict(os.environ, PYTHONPATH=b + os.pathsep + SHARED, OMP_NUM_THREADS=threads,
+                       OPENBLAS_NUM_THREADS=threads)
             out = subprocess.run(launcher + [os.path.abspath(__file__), "--child"] + passed, env=env,
                                  capture_output=True, text=True)
             line = [x for x in out.stdout.splitlines() if x.startswith("RESULT ")]

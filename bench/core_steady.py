@@ -10,33 +10,14 @@ the guard pays on every new mesh.
 Set beside bench/growth.py's flow step of pfv.FlowEngine in YADE on the same lattice, the difference is what the step
 costs outside the core (reading positions, writing forces, the time-step guard). No timing is asserted anywhere.
 """
-import os
 import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from lattice import jittered_lattice  # noqa: E402
-
-import pfv  # noqa: E402
+from pfv_testing.lattice import lattice_permeameter
 
 KEYS = ('volumes', 'solve', 'forces', 'total')
-
-
-def lattice_permeameter(n):
-    """The engine (not yet stepped), centres, radii and walls of the scene above; shared with
-    bench/multigrid_smoothers.py."""
-    pos, rad = jittered_lattice(n)
-    lo, hi = (pos - rad[:, None]).min(0), (pos + rad[:, None]).max(0)
-    walls = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
-    e = pfv.Engine()
-    e.bnd_is_pressure = [False, False, True, True, False, False]
-    e.bnd_value = [0, 0, 100.0, 0, 0, 0]
-    e.viscosity = 1e-3
-    e.mesh_update_interval = 10 ** 9
-    e.solver = 'multigrid'
-    return e, pos, rad, walls
 
 
 def measure(n, steady=5):

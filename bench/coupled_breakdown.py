@@ -12,20 +12,12 @@ asserted anywhere.
 """
 import cProfile
 import io
-import os
 import pstats
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
-import growth  # noqa: E402  (its scene and engine settings)
-
-
-def option(name, default):
-    for a in sys.argv[1:]:
-        if a.startswith('--%s=' % name):
-            return type(default)(float(a.split('=', 1)[1]))
-    return default
+from pfv_testing.cli import option
+from pfv_testing.lattice_scene import build_scene, insert, make_flow
 
 
 def profile_step(label, rows=12):
@@ -45,16 +37,16 @@ def profile_step(label, rows=12):
 
 def main():
     from yade import O
-    n = option('n', 1000000)
-    growth.build_scene(n)
+    n = option(sys.argv[1:], 'n', 1000000)
+    build_scene(n)
     dry = []
     for _ in range(3):
         t0 = time.perf_counter()
         O.step()
         dry.append(time.perf_counter() - t0)
     print('N = %d: dry steps %s s' % (n, ', '.join('%.3f' % d for d in dry)))
-    flow = growth.make_flow('pfv-multigrid')
-    growth.insert(flow)
+    flow = make_flow('pfv-multigrid')
+    insert(flow)
     profile_step('first coupled step')
     print('   of which the core step %.2f s' % flow.core.step_times()['total'])
     for _ in range(2):

@@ -16,8 +16,7 @@ import subprocess
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from core_steady import lattice_permeameter  # noqa: E402
+from pfv_testing.lattice import lattice_permeameter
 
 STAGES = ('triangulation', 'geometry', 'conductance', 'force_cache', 'assembly', 'analysis', 'factorization')
 

@@ -11,14 +11,12 @@ step-to-step change of the pressures, and the largest |p_mixed - p_double| / max
 deterministic at -j1, so both runs see the same positions up to the feedback of that difference). Unlike
 bench/solver_stages.py the factor is evicted from the cache by the DEM between two solves, as in a real run.
 """
-import os
 import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
-import flow_benchmark as fb  # noqa: E402  (packing cache, scene, engine set-up)
-from solver_stages import option  # noqa: E402
+from pfv_testing.cli import option
+from pfv_testing.flow_bench import scene as fb  # packing cache, scene, engine set-up
 
 from yade import O  # noqa: E402
 
@@ -52,9 +50,9 @@ def run(steps, mixed, tolerance=None):
 
 
 def main():
-    n = option('size', 10000)
-    steps = option('steps', 20)
-    tolerances = [float(t) for t in option('tolerances', '1e-10,1e-8').split(',')]
+    n = option(sys.argv[1:], 'size', 10000)
+    steps = option(sys.argv[1:], 'steps', 20)
+    tolerances = [float(t) for t in option(sys.argv[1:], 'tolerances', '1e-10,1e-8').split(',')]
     fb.build_scene(n)
     O.saveTmp('bench')
     reference = run(steps, False)

@@ -25,15 +25,13 @@ median over its steps of the core's solve stage (step_times()) and of the whole 
 round the ratio of each smoother's solve median to the symmetric Gauss-Seidel's of that round. No timing is asserted
 anywhere.
 """
-import os
 import statistics
 import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from core_steady import lattice_permeameter  # noqa: E402
+from pfv_testing.lattice import lattice_permeameter
 
 SMOOTHERS = ("gauss_seidel", "split_gauss_seidel", "jacobi")
 # name, strain of the squeeze after k steps, random displacement per step in radii, steps

@@ -15,13 +15,7 @@ import sys
 
 import numpy as np
 import pfv
-
-
-def option(name, default):
-    for a in sys.argv[1:]:
-        if a.startswith(f"--{name}="):
-            return type(default)(a.split("=", 1)[1])
-    return default
+from pfv_testing.cli import option
 
 
 def rss_mb():
@@ -30,9 +24,9 @@ def rss_mb():
 
 
 def main():
-    steps, n_target = option("steps", 20000), option("spheres", 2000)
-    remesh, every = option("remesh", 50), option("every", 1000)
-    max_growth, max_error = option("max-growth", 5.0), option("max-error", 1e-8)
+    steps, n_target = option(sys.argv[1:], "steps", 20000), option(sys.argv[1:], "spheres", 2000)
+    remesh, every = option(sys.argv[1:], "remesh", 50), option(sys.argv[1:], "every", 1000)
+    max_growth, max_error = option(sys.argv[1:], "max-growth", 5.0), option(sys.argv[1:], "max-error", 1e-8)
     m = max(2, round(n_target ** (1 / 3)))
     rng = np.random.default_rng(7)
     base = (np.indices((m, m, m)).reshape(3, -1).T + 0.5) / m

@@ -37,28 +37,20 @@ packing (made by bench/flow_benchmark.py).
 Minimum and median over repetitions; no DEM runs between the solves (doc/benchmarks.md gives the in-loop numbers;
 section 2 imitates the DEM's eviction of the factor).
 """
-import os
 import resource
 import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))
-import flow_benchmark as fb  # noqa: E402  (packing cache)
+from pfv_testing.cli import option
+from pfv_testing.flow_bench import scene as fb  # the packing cache
 
 import pfv  # noqa: E402
 import yade  # noqa: E402
 from yade import O, utils  # noqa: E402
 from yade.minieigenHP import Vector3  # noqa: E402
 from yade._packSpheres import SpherePack  # noqa: E402
-
-
-def option(name, default):
-    for a in sys.argv[1:]:
-        if a.startswith('--%s=' % name):
-            return type(default)(a.split('=', 1)[1])
-    return default
 
 
 def stats(times):
@@ -320,14 +312,14 @@ def parallel_ordering(pos, rad, walls, repeats=5):
 
 
 def main():
-    n = option('size', 10000)
+    n = option(sys.argv[1:], 'size', 10000)
     spheres, meta = fb.read_packing(n)
     a = np.array(spheres, dtype=float)
     pos, rad = a[:, :3].copy(), a[:, 3].copy()
     L = meta.get('box', fb.box_side(n))
     walls = [0, L, 0, L, 0, L]
     print('solver_stages: N = %d, packing %s' % (n, fb.packing_path(n)))
-    sections = option('sections', '1,2,3,4,5,6,7,8,9').split(',')
+    sections = option(sys.argv[1:], 'sections', '1,2,3,4,5,6,7,8,9').split(',')
     if '1' in sections:
         ordering(pos, rad, walls)
     if '2' in sections:

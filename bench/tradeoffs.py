@@ -65,6 +65,7 @@ os.environ.setdefault('OMP_NUM_THREADS', '1')
 os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
 
 import numpy as np  # noqa: E402
+from pfv_testing.cli import option  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
@@ -92,16 +93,6 @@ SOLVER_TOLS = {
     ('slow', 'quick'): {0: [1e-3, 1e-6], 1: [1e-3, 1e-6]},
     ('fast', 'quick'): {0: [1e-4, 1e-6], 1: [1e-6]},
 }
-
-
-def option(name, default):
-    for a in sys.argv[1:]:
-        if a == f'--{name}' and isinstance(default, bool):
-            return True
-        if a.startswith(f'--{name}='):
-            v = a.split('=', 1)[1]
-            return v if isinstance(default, str) else type(default)(v)
-    return default
 
 
 def log(*a):
@@ -529,12 +520,12 @@ def write_report(path, text):
 
 # ---------------------------------------------------------------------------------------------------------- main
 def main():
-    quick = option('quick', False)
-    work = option('work', '/tmp/trade')
+    quick = option(sys.argv[1:], 'quick', False)
+    work = option(sys.argv[1:], 'work', '/tmp/trade')
     os.makedirs(work, exist_ok=True)
-    sizes = [int(s) for s in option('sizes', '250,1000' if quick else '1000,5000').split(',')]
-    rounds = option('rounds', 2 if quick else 3)
-    part = option('part', '')
+    sizes = [int(s) for s in option(sys.argv[1:], 'sizes', '250,1000' if quick else '1000,5000').split(',')]
+    rounds = option(sys.argv[1:], 'rounds', 2 if quick else 3)
+    part = option(sys.argv[1:], 'part', '')
     if part:
         import pfv
         pfv.set_num_threads(1)
@@ -546,11 +537,11 @@ def main():
             json.dump(res, f)
         return 0
     tasks = [(s, n) for n in sorted(sizes, reverse=True) for s in ('slow', 'fast', 'perm')]
-    todo = [(s, int(n)) for s, n in (t.split(':') for t in option('tasks', '').split(',') if t)] or tasks
-    if not option('report-only', False):
+    todo = [(s, int(n)) for s, n in (t.split(':') for t in option(sys.argv[1:], 'tasks', '').split(',') if t)] or tasks
+    if not option(sys.argv[1:], 'report-only', False):
         for n in sizes:
             packing(n, work)
-        jobs = option('jobs', 1)
+        jobs = option(sys.argv[1:], 'jobs', 1)
         env = dict(os.environ, OMP_NUM_THREADS='1', OPENBLAS_NUM_THREADS='1')
         running, pending = [], list(todo)   # largest first: the biggest task starts at once
         while pending or running:
@@ -575,11 +566,11 @@ def main():
         a for a in sys.argv[1:] if not a.startswith('--report-only'))
     text = report(parts, command.strip(), quick)
     print(text)
-    out = option('out', '')
+    out = option(sys.argv[1:], 'out', '')
     if out:
         write_report(out, text)
-        fig = option('figure', os.path.join(os.path.dirname(out) or '.', 'figures',
-                                            'tradeoffs_quick.png' if quick else 'tradeoffs.png'))
+        fig = option(sys.argv[1:], 'figure', os.path.join(os.path.dirname(out) or '.', 'figures',
+                                                          'tradeoffs_quick.png' if quick else 'tradeoffs.png'))
         figure(parts, fig)
         log('wrote', out, 'and', fig)
     return 0

@@ -15,11 +15,11 @@ it existed) when PYTHONPATH points there. Timing only: nothing is asserted.
 import argparse
 import json
 import statistics
-import time
 
 import numpy as np
 
 from pfv._core import Engine
+from pfv_testing.timing import wall
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--n", type=int, default=20)
@@ -49,9 +49,7 @@ def engine(mode):
 
 
 def timed_step(e, x):
-    t0 = time.perf_counter()
-    e.step(x, radii, walls, dt)
-    return time.perf_counter() - t0
+    return wall(lambda: e.step(x, radii, walls, dt))
 
 
 results = {}

@@ -24,8 +24,7 @@ import sys
 import time
 
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # bench/
-from lattice import jittered_lattice  # noqa: E402
+from pfv_testing.lattice import jittered_lattice
 from yade import O, utils  # noqa: E402
 from yade.wrapper import FlowEngine as YadeFlowEngine, ForceResetter, FrictMat, NewtonIntegrator  # noqa: E402
 

@@ -15,14 +15,12 @@ built during the timed blocks (checked). No timing is asserted.
 """
 from __future__ import annotations
 
-import os
 import statistics
 import sys
 import time
 
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # bench/
-from lattice import jittered_lattice  # noqa: E402
+from pfv_testing.lattice import jittered_lattice
 from yade import O, utils  # noqa: E402
 from yade.wrapper import ForceResetter, FrictMat, NewtonIntegrator  # noqa: E402
 

@@ -2,17 +2,14 @@
 
     yade-double -j1 -n -x bench/yade_wave_action.py
 
-Scene: the shipped 1000-sphere packing in the unit cube (tests/yade/scenes.py), frozen, ymax the only pressure wall,
+Scene: the shipped 1000-sphere packing in the unit cube (pfv_testing.scenes), frozen, ymax the only pressure wall,
 waveAction on with sineAverage = 10, sineMagnitude = 5. Prints probe pressures after the first step, after changing
 sineMagnitude to 20 (no remesh), after updateBCs(), and after a retriangulation; then how the imposed top cells'
 pressures compare with the cosine at their own x and with the 30 levels cos(pi k / 30) of YADE's bins.
 """
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "..", "tests", "yade"))
-import scenes  # noqa: E402
+from pfv_testing import scenes
 from yade import O  # noqa: E402
 from yade.wrapper import FlowEngine  # noqa: E402
 

@@ -35,7 +35,8 @@ measured again at the end give C_v,final, and U(T_v) is compared with both the i
 Results with both engines, and why the time step is what it is: doc/validation.md.
 
 Outputs in --out (default ./oedometer-<engine>[-quick][-nonlinear]): timeseries.csv, isochrones.csv, summary.json,
-oedometer.png. The exit status is 0 when the run completes (the thresholds are in tests/yade/test_oedometer_quick.py).
+oedometer.png. The exit status is 0 when the run completes (the thresholds are in
+tests/yade/examples/test_oedometer_quick.py).
 Pressures are piezometric (no gravity anywhere in this example).
 """
 import hashlib

@@ -8,9 +8,8 @@ direct solution, which `build/pfv_amg_solve FOLDER` compares its own against. Pr
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-import pfv  # noqa: E402
-from lattice import jittered_lattice  # noqa: E402
+import pfv
+from pfv_testing.lattice import jittered_lattice
 
 n, folder = int(float(sys.argv[1])), sys.argv[2]
 centres, radii = jittered_lattice(n, 1)

@@ -1,5 +1,5 @@
 // A settings change through the C++ API rebuilds what the table in
-// tests/data/settings_invalidation.csv says; tests/yade/test_settings_invalidation.py checks the
+// tests/data/settings_invalidation.csv says; tests/yade/engine/test_settings_invalidation.py checks the
 // same table through the Python bindings and through pfv.FlowEngine.
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 """Names of YADE 2023.02a's FlowEngine attributes and methods (generated from
-tests/yade/yade_flowengine_attributes.txt, itself read off yade-double).
+tests/data/yade_flowengine_attributes.txt, itself read off yade-double).
 
 pfv.FlowEngine uses them to tell "YADE has this but PFV does not support it yet" apart
 from a misspelt name.

@@ -51,9 +51,18 @@ def lattice_child(argv):
         remesh.append(timed_step())
         for _ in range(2):
             timed_step()
-    print("RESULT " + json.dumps(dict(steady=statistics.median(steady), solve=statistics.median(solve),
-                                      remesh=statistics.median(remesh), cells=e.n_cells(),
-                                      package=__import__("pfv").__file__)))
+    print(
+        "RESULT "
+        + json.dumps(
+            dict(
+                steady=statistics.median(steady),
+                solve=statistics.median(solve),
+                remesh=statistics.median(remesh),
+                cells=e.n_cells(),
+                package=__import__("pfv").__file__,
+            )
+        )
+    )
 
 
 def child(argv):
@@ -84,8 +93,17 @@ def child(argv):
         remesh.append(timed_step())
         for _ in range(2):
             timed_step()
-    print("RESULT " + json.dumps(dict(steady=statistics.median(steady), remesh=statistics.median(remesh),
-                                      cells=flow.nCells(), package=__import__("pfv").__file__)))
+    print(
+        "RESULT "
+        + json.dumps(
+            dict(
+                steady=statistics.median(steady),
+                remesh=statistics.median(remesh),
+                cells=flow.nCells(),
+                package=__import__("pfv").__file__,
+            )
+        )
+    )
 
 
 def driver(argv):
@@ -101,20 +119,25 @@ def driver(argv):
         launcher = ["yade-double", "-j" + threads, "-n", "-x"]
     results = {b: [] for b in builds}
     for r in range(rounds):
-        for b in (builds if r % 2 == 0 else builds[::-1]):
+        for b in builds if r % 2 == 0 else builds[::-1]:
             # The build's pfv first; pfv_testing from where this driver found it (an old build may lack it).
-            env = dict(os.environ, PYTHONPATH=b + os.pathsep + SHARED, OMP_NUM_THREADS=threads,
-                       OPENBLAS_NUM_THREADS=threads)
-            out = subprocess.run(launcher + [os.path.abspath(__file__), "--child"] + passed, env=env,
-                                 capture_output=True, text=True)
+            env = dict(
+                os.environ, PYTHONPATH=b + os.pathsep + SHARED, OMP_NUM_THREADS=threads, OPENBLAS_NUM_THREADS=threads
+            )
+            out = subprocess.run(
+                launcher + [os.path.abspath(__file__), "--child"] + passed, env=env, capture_output=True, text=True
+            )
             line = [x for x in out.stdout.splitlines() if x.startswith("RESULT ")]
             if out.returncode != 0 or not line:
                 sys.exit(f"child failed for {b}:\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}")
-            res = json.loads(line[-1][len("RESULT "):])
+            res = json.loads(line[-1][len("RESULT ") :])
             results[b].append(res)
             solve = f" (solve {res['solve'] * 1e3:.2f} ms)" if "solve" in res else ""
-            print(f"round {r + 1} {b}: steady {res['steady'] * 1e3:.2f} ms{solve}, remesh {res['remesh']:.3f} s "
-                  f"({res['cells']} cells, {res['package']})", flush=True)
+            print(
+                f"round {r + 1} {b}: steady {res['steady'] * 1e3:.2f} ms{solve}, remesh {res['remesh']:.3f} s "
+                f"({res['cells']} cells, {res['package']})",
+                flush=True,
+            )
     keys = [k for k in ("steady", "solve", "remesh") if k in results[builds[0]][0]]
     med = {b: {k: statistics.median(x[k] for x in results[b]) for k in keys} for b in builds}
     for b in builds:

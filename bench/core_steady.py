@@ -34,24 +34,28 @@ def measure(n, steady=5):
         iterations.append(e.cg_iterations)
     med = {k: float(np.median([s[k] for s in stages])) for k in KEYS}
     t0 = time.perf_counter()
-    e.viscous_stability_bound(2600 * 4 / 3 * np.pi * rad ** 3)
+    e.viscous_stability_bound(2600 * 4 / 3 * np.pi * rad**3)
     bound = time.perf_counter() - t0
     return dict(n=n, cells=e.n_cells(), first=first, steady=walls_s, median=med, iterations=iterations, bound=bound)
 
 
 def main(argv):
     sizes = [int(float(a)) for a in argv] or [250000, 500000, 1000000]
-    print('| N | cells | first step [s] | steady step [s] | dV/dt [ms] | solve [ms] | CG iterations | forces [ms] '
-          '| per sphere [µs] | guard bound [s] |')
+    print(
+        '| N | cells | first step [s] | steady step [s] | dV/dt [ms] | solve [ms] | CG iterations | forces [ms] '
+        '| per sphere [µs] | guard bound [s] |'
+    )
     print('|---|---|---|---|---|---|---|---|---|---|')
     for n in sizes:
         r = measure(n)
         m = r['median']
         lo, hi = min(r['iterations']), max(r['iterations'])
         its = f"{lo}" if lo == hi else f"{lo}–{hi}"
-        row = (f"| {n:,} | {r['cells']:,} | {r['first']:.1f} | {m['total']:.3f} | {1e3 * m['volumes']:.0f} | "
-               f"{1e3 * m['solve']:.0f} | {its} | {1e3 * m['forces']:.0f} | {1e6 * m['total'] / n:.2f} | "
-               f"{r['bound']:.2f} |")
+        row = (
+            f"| {n:,} | {r['cells']:,} | {r['first']:.1f} | {m['total']:.3f} | {1e3 * m['volumes']:.0f} | "
+            f"{1e3 * m['solve']:.0f} | {its} | {1e3 * m['forces']:.0f} | {1e6 * m['total'] / n:.2f} | "
+            f"{r['bound']:.2f} |"
+        )
         print(row.replace(',', '\u202f'), flush=True)
     return 0
 

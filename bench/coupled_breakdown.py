@@ -22,6 +22,7 @@ from pfv_testing.lattice_scene import build_scene, insert, make_flow
 
 def profile_step(label, rows=12):
     from yade import O
+
     pr = cProfile.Profile()
     t0 = time.perf_counter()
     pr.enable()
@@ -37,6 +38,7 @@ def profile_step(label, rows=12):
 
 def main():
     from yade import O
+
     n = option(sys.argv[1:], 'n', 1000000)
     build_scene(n)
     dry = []
@@ -57,9 +59,14 @@ def main():
     t0 = time.perf_counter()
     O.step()
     wall = time.perf_counter() - t0
-    print('steady coupled step: %.3f s of wall time, the core step %.3f s; execTime by engine: %s'
-          % (wall, flow.core.step_times()['total'],
-             ', '.join('%s %.3f s' % (type(e).__name__, e.execTime * 1e-9) for e in O.engines)))
+    print(
+        'steady coupled step: %.3f s of wall time, the core step %.3f s; execTime by engine: %s'
+        % (
+            wall,
+            flow.core.step_times()['total'],
+            ', '.join('%s %.3f s' % (type(e).__name__, e.execTime * 1e-9) for e in O.engines),
+        )
+    )
     profile_step('next steady coupled step')
     return 0
 

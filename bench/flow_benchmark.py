@@ -69,8 +69,14 @@ import traceback
 from pfv_testing import paths
 from pfv_testing.flow_bench.machine import machine_description, pfv_fingerprint
 from pfv_testing.flow_bench.options import parse_args
-from pfv_testing.flow_bench.report import (REPORT_VERSION, STARTUP_BEGIN_MARK, STARTUP_END_MARK, report,
-                                           startup_report, write_report)
+from pfv_testing.flow_bench.report import (
+    REPORT_VERSION,
+    STARTUP_BEGIN_MARK,
+    STARTUP_END_MARK,
+    report,
+    startup_report,
+    write_report,
+)
 from pfv_testing.flow_bench.scene import generate_packing, log, packing_digest, packing_path, read_packing
 from pfv_testing.flow_bench.summary import startup_summary, summarise
 from pfv_testing.flow_bench.trials import memory_child, startup_child, timing_child
@@ -114,8 +120,12 @@ def startup_driver(opts, argv):
         if not os.path.exists(packing_path(n)):
             log('generating packing n=%d into %s (once; cached)' % (n, packing_path(n)))
             run_child(['--child=generate', '--size=%d' % n], opts['gen_threads'] or 1, 'generate-%d' % n)
-    child_opts = ['--startup', '--sizes=' + ','.join(map(str, opts['sizes'])), '--rounds=%d' % opts['rounds'],
-                  '--steady=%d' % opts['steady']]
+    child_opts = [
+        '--startup',
+        '--sizes=' + ','.join(map(str, opts['sizes'])),
+        '--rounds=%d' % opts['rounds'],
+        '--steady=%d' % opts['steady'],
+    ]
     texts, raw = [], {}
     for t in opts['threads']:
         data = run_child(['--child=startup'] + child_opts, t, 'startup-j%d' % t)
@@ -137,8 +147,10 @@ def driver(opts, argv):
     started = datetime.datetime.now().strftime('%Y-%m-%d %H:%M')
     command = 'yade-double -n -x bench/flow_benchmark.py' + ('' if not argv else ' ' + ' '.join(argv))
     machine = machine_description()
-    log('machine: %s, %s CPUs, %s; load %s' % (machine.get('Model name'), machine.get('CPU(s)'), machine.get('RAM'),
-                                               machine['load average at start']))
+    log(
+        'machine: %s, %s CPUs, %s; load %s'
+        % (machine.get('Model name'), machine.get('CPU(s)'), machine.get('RAM'), machine['load average at start'])
+    )
     need = sorted(set(opts['sizes']) | (set(opts['oedo_sizes']) if opts['oedometer'] else set()))
     gen_threads = opts['gen_threads'] or max(opts['threads'] + [1])
     packings = {}
@@ -150,9 +162,14 @@ def driver(opts, argv):
         meta['digest'] = packing_digest(spheres)
         packings[n] = meta
         log('packing n=%d: %s, porosity %.4f, digest %s' % (n, packing_path(n), meta['porosity'], meta['digest']))
-    child_opts = ['--sizes=' + ','.join(map(str, opts['sizes'])), '--rounds=%d' % opts['rounds'],
-                  '--steady=%d' % opts['steady'], '--oedo-sizes=' + ','.join(map(str, opts['oedo_sizes'])),
-                  '--oedo-steps=%d' % opts['oedo_steps'], '--oedo-interval=%d' % opts['oedo_interval']]
+    child_opts = [
+        '--sizes=' + ','.join(map(str, opts['sizes'])),
+        '--rounds=%d' % opts['rounds'],
+        '--steady=%d' % opts['steady'],
+        '--oedo-sizes=' + ','.join(map(str, opts['oedo_sizes'])),
+        '--oedo-steps=%d' % opts['oedo_steps'],
+        '--oedo-interval=%d' % opts['oedo_interval'],
+    ]
     if not opts['oedometer']:
         child_opts.append('--no-oedometer')
     if not opts['multithread']:
@@ -168,13 +185,21 @@ def driver(opts, argv):
     if opts['memory']:
         for n in opts['sizes']:
             for kind in ('dry', 'yade', 'pfv'):
-                memory.append(run_child(['--child=memory', '--size=%d' % n, '--engine=' + kind,
-                                         '--steady=%d' % opts['steady']] + (['--quick'] if opts['quick'] else []),
-                                        1, 'memory-%s-%d' % (kind, n)))
+                memory.append(
+                    run_child(
+                        ['--child=memory', '--size=%d' % n, '--engine=' + kind, '--steady=%d' % opts['steady']]
+                        + (['--quick'] if opts['quick'] else []),
+                        1,
+                        'memory-%s-%d' % (kind, n),
+                    )
+                )
     finished = datetime.datetime.now().strftime('%Y-%m-%d %H:%M')
     builds = sorted(set(d.get('pfv_build') for d in list(timing.values()) + memory if d.get('pfv_build')))
-    machine['pfv extension'] = ' | '.join(builds) + (' -- WARNING: the children used different pfv builds '
-                                                     '(pfv was reinstalled during the run)' if len(builds) > 1 else '')
+    machine['pfv extension'] = ' | '.join(builds) + (
+        ' -- WARNING: the children used different pfv builds ' '(pfv was reinstalled during the run)'
+        if len(builds) > 1
+        else ''
+    )
     if len(builds) > 1:
         log('WARNING: pfv was reinstalled during the run: %s' % builds)
     machine['load average at end'] = ' '.join('%.2f' % x for x in os.getloadavg())
@@ -184,9 +209,23 @@ def driver(opts, argv):
     write_report(opts['out'], text)
     os.makedirs(os.path.dirname(os.path.abspath(opts['json'])), exist_ok=True)
     with open(opts['json'], 'w') as f:
-        json.dump(dict(version=REPORT_VERSION, command=command, started=started, finished=finished, machine=machine,
-                       packings={str(k): v for k, v in packings.items()}, summary=summ, memory=mem, timing=timing,
-                       memory_raw=memory), f, indent=1, default=str)
+        json.dump(
+            dict(
+                version=REPORT_VERSION,
+                command=command,
+                started=started,
+                finished=finished,
+                machine=machine,
+                packings={str(k): v for k, v in packings.items()},
+                summary=summ,
+                memory=mem,
+                timing=timing,
+                memory_raw=memory,
+            ),
+            f,
+            indent=1,
+            default=str,
+        )
     log('report written to %s, raw data to %s' % (opts['out'], opts['json']))
     return 0
 
@@ -197,8 +236,10 @@ def report_only(opts):
     with open(opts['json']) as f:
         data = json.load(f)
     if data.get('version') != REPORT_VERSION:
-        raise SystemExit('flow_benchmark: %s has layout version %s, this script writes %s'
-                         % (opts['json'], data.get('version'), REPORT_VERSION))
+        raise SystemExit(
+            'flow_benchmark: %s has layout version %s, this script writes %s'
+            % (opts['json'], data.get('version'), REPORT_VERSION)
+        )
     run = parse_args(data['command'].split()[4:])
     packings = {int(n): m for n, m in data['packings'].items() if int(n) in run['sizes']}
     summ, mem = summarise(data['timing'], data['memory_raw'])

@@ -55,8 +55,19 @@ KINDS = ("yade", "pfv", "pfv-multigrid")
 
 
 def options(argv):
-    o = dict(sizes="1e4,5e4,2e5", pfv_sizes="5e5,1e6:mg", blocks="5", out="", figure="",
-             json="/tmp/bench/growth.json", child="", n="0", kinds="", quick=False, report_only=False)
+    o = dict(
+        sizes="1e4,5e4,2e5",
+        pfv_sizes="5e5,1e6:mg",
+        blocks="5",
+        out="",
+        figure="",
+        json="/tmp/bench/growth.json",
+        child="",
+        n="0",
+        kinds="",
+        quick=False,
+        report_only=False,
+    )
     for a in argv:
         if a == "--quick":
             o["quick"] = True
@@ -158,8 +169,9 @@ def run_child(args):
 def blocks_of(tr):
     """Per block of a trial: (median coupled step, dry step next to it)."""
     med = statistics.median
-    return [(med(c), 0.5 * (med(before) + med(after))) for c, before, after in zip(tr["coupled"], tr["dry"],
-                                                                                   tr["dry"][1:])]
+    return [
+        (med(c), 0.5 * (med(before) + med(after))) for c, before, after in zip(tr["coupled"], tr["dry"], tr["dry"][1:])
+    ]
 
 
 def summarise(timing, memory):
@@ -177,10 +189,22 @@ def summarise(timing, memory):
             remesh = sum(tr["remesh"]) - (WINDOW - 1) * coupled - dry
             mem = [m for m in memory if not m.get("failed") and m["n"] == t["n"] and m["kind"] == kind]
             peak = (mem[0]["peak_kb"] - mem[0]["before_kb"]) / 1024 if mem else None
-            rows.append(dict(n=t["n"], kind=kind, first=tr["first"][0] - dry, remesh=remesh, flow=flow, dry=dry,
-                             coupled_over_dry=statistics.median(ratios), ratio_range=(min(ratios), max(ratios)),
-                             peak_mb=peak, choice=tr.get("solver_choice", ""),
-                             iterations=tr.get("cg_iterations"), steady_iterations=tr.get("steady_cg_iterations")))
+            rows.append(
+                dict(
+                    n=t["n"],
+                    kind=kind,
+                    first=tr["first"][0] - dry,
+                    remesh=remesh,
+                    flow=flow,
+                    dry=dry,
+                    coupled_over_dry=statistics.median(ratios),
+                    ratio_range=(min(ratios), max(ratios)),
+                    peak_mb=peak,
+                    choice=tr.get("solver_choice", ""),
+                    iterations=tr.get("cg_iterations"),
+                    steady_iterations=tr.get("steady_cg_iterations"),
+                )
+            )
     return rows
 
 
@@ -201,18 +225,23 @@ def fit_exponent(ns, ys):
 
 def _cost_table(rows):
     """Each engine's costs at each N."""
-    L = ["| N | engine | first step [s] | remesh [s] | flow step [ms] | dry DEM step [ms] | "
-         "coupled / dry (blocks) | peak RSS [MB] | PFV's solver |"]
+    L = [
+        "| N | engine | first step [s] | remesh [s] | flow step [ms] | dry DEM step [ms] | "
+        "coupled / dry (blocks) | peak RSS [MB] | PFV's solver |"
+    ]
     L.append("|---|---|---|---|---|---|---|---|---|")
     for r in sorted(rows, key=lambda r: (r["n"], KINDS.index(r["kind"]))):
         peak = f"{r['peak_mb']:.0f}" if r["peak_mb"] is not None else "–"
-        counts = ([f"{r['steady_iterations']} per steady step"] if r["steady_iterations"] else []) + \
-            ([f"{r['iterations']} after the remesh"] if r["iterations"] else [])
+        counts = ([f"{r['steady_iterations']} per steady step"] if r["steady_iterations"] else []) + (
+            [f"{r['iterations']} after the remesh"] if r["iterations"] else []
+        )
         choice = r["choice"].split(":")[0] + (", CG iterations " + " and ".join(counts) if counts else "")
         choice = choice if r["kind"] != "yade" else ""
-        L.append(f"| {size(r['n'])} | {r['kind']} | {r['first']:.2f} | {r['remesh']:.2f} | {1e3 * r['flow']:.1f} | "
-                 f"{1e3 * r['dry']:.1f} | {r['coupled_over_dry']:.2f} ({r['ratio_range'][0]:.2f}–"
-                 f"{r['ratio_range'][1]:.2f}) | {peak} | {choice} |")
+        L.append(
+            f"| {size(r['n'])} | {r['kind']} | {r['first']:.2f} | {r['remesh']:.2f} | {1e3 * r['flow']:.1f} | "
+            f"{1e3 * r['dry']:.1f} | {r['coupled_over_dry']:.2f} ({r['ratio_range'][0]:.2f}–"
+            f"{r['ratio_range'][1]:.2f}) | {peak} | {choice} |"
+        )
     L.append("")
     return L
 
@@ -228,13 +257,18 @@ def _ratio_table(rows):
         for kind in ("pfv", "pfv-multigrid"):
             p = by.get((n, kind))
             if p:
-                mem = (f"{p['peak_mb'] / y['peak_mb']:.2f}" if p["peak_mb"] and y["peak_mb"] else "–")
-                ratios.append(f"| {size(n)} | {kind} | {p['first'] / y['first']:.2f} | "
-                              f"{p['remesh'] / y['remesh']:.2f} | {p['flow'] / y['flow']:.2f} | {mem} |")
+                mem = f"{p['peak_mb'] / y['peak_mb']:.2f}" if p["peak_mb"] and y["peak_mb"] else "–"
+                ratios.append(
+                    f"| {size(n)} | {kind} | {p['first'] / y['first']:.2f} | "
+                    f"{p['remesh'] / y['remesh']:.2f} | {p['flow'] / y['flow']:.2f} | {mem} |"
+                )
     if not ratios:
         return []
-    return ["PFV / YADE:", "", "| N | PFV | first step | remesh | flow step | peak RSS |",
-            "|---|---|---|---|---|---|"] + ratios + [""]
+    return (
+        ["PFV / YADE:", "", "| N | PFV | first step | remesh | flow step | peak RSS |", "|---|---|---|---|---|---|"]
+        + ratios
+        + [""]
+    )
 
 
 def _exponent_table(rows):
@@ -246,26 +280,53 @@ def _exponent_table(rows):
             continue
         ns = [r["n"] for r in rs]
         e = {q: fit_exponent(ns, [r[q] for r in rs]) for q in ("first", "remesh", "flow", "peak_mb")}
-        fits.append(f"| {kind} | {size(ns[0])}–{size(ns[-1])} | " + " | ".join(
-            f"{e[q]:.2f}" if e[q] is not None else "–" for q in ("first", "remesh", "flow", "peak_mb")) + " |")
+        fits.append(
+            f"| {kind} | {size(ns[0])}–{size(ns[-1])} | "
+            + " | ".join(f"{e[q]:.2f}" if e[q] is not None else "–" for q in ("first", "remesh", "flow", "peak_mb"))
+            + " |"
+        )
     if not fits:
         return []
-    return ["Fitted exponents a of cost ∝ N^a (least squares on log–log over the sizes measured):", "",
-            "| engine | N | first step | remesh | flow step | peak RSS |", "|---|---|---|---|---|---|"] + fits + [""]
+    return (
+        [
+            "Fitted exponents a of cost ∝ N^a (least squares on log–log over the sizes measured):",
+            "",
+            "| engine | N | first step | remesh | flow step | peak RSS |",
+            "|---|---|---|---|---|---|",
+        ]
+        + fits
+        + [""]
+    )
 
 
 def _stage_table(data):
     """PFV's forced remesh by stage."""
-    stages = [(t["n"], kind, tr["remesh_times"]) for t in data["timing"] if not t.get("failed")
-              for kind, tr in t["trials"].items() if "remesh_times" in tr]
+    stages = [
+        (t["n"], kind, tr["remesh_times"])
+        for t in data["timing"]
+        if not t.get("failed")
+        for kind, tr in t["trials"].items()
+        if "remesh_times" in tr
+    ]
     if not stages:
         return []
-    keys = ("triangulation", "geometry", "conductance", "force_cache", "assembly", "analysis", "factorization",
-            "carry_over")
-    L = ["PFV's forced remesh by stage (`remesh_times()` after the remesh window) [s]; the rest of the window is "
-         "the first solves on the new mesh, the time-step guard and the exchange with YADE:", "",
-         "| N | engine | " + " | ".join(k.replace("_", " ") for k in keys) + " |",
-         "|---|---|" + "---|" * len(keys)]
+    keys = (
+        "triangulation",
+        "geometry",
+        "conductance",
+        "force_cache",
+        "assembly",
+        "analysis",
+        "factorization",
+        "carry_over",
+    )
+    L = [
+        "PFV's forced remesh by stage (`remesh_times()` after the remesh window) [s]; the rest of the window is "
+        "the first solves on the new mesh, the time-step guard and the exchange with YADE:",
+        "",
+        "| N | engine | " + " | ".join(k.replace("_", " ") for k in keys) + " |",
+        "|---|---|" + "---|" * len(keys),
+    ]
     for n, kind, st in sorted(stages, key=lambda x: (x[0], KINDS.index(x[1]))):
         L.append(f"| {size(n)} | {kind} | " + " | ".join(f"{st.get(k, 0.0):.2f}" for k in keys) + " |")
     L.append("")
@@ -274,8 +335,11 @@ def _stage_table(data):
 
 def report(data, command):
     rows = summarise(data["timing"], data["memory"])
-    L = [f"Produced by `{command}` (one thread per process; per trial {data['blocks']} blocks of {BLOCK} coupled "
-         f"steps, each between blocks of {BLOCK} dry steps).", ""]
+    L = [
+        f"Produced by `{command}` (one thread per process; per trial {data['blocks']} blocks of {BLOCK} coupled "
+        f"steps, each between blocks of {BLOCK} dry steps).",
+        "",
+    ]
     L += _cost_table(rows) + _ratio_table(rows) + _exponent_table(rows) + _stage_table(data)
     failed = [c for c in data["timing"] + data["memory"] if c.get("failed")]
     for c in failed:
@@ -285,8 +349,10 @@ def report(data, command):
 
 def figure(rows, path):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     fig, axes = plt.subplots(1, 3, figsize=(13, 4))
     style = {"yade": ("C3", "YADE"), "pfv": ("C0", "PFV (auto)"), "pfv-multigrid": ("C2", "PFV multigrid")}
     for kind in KINDS:
@@ -305,8 +371,9 @@ def figure(rows, path):
             axes[2].loglog([m[0] for m in mem], [m[1] / 1024 for m in mem], "o-", color=c, label=label)
     axes[2].axhline(24, color="grey", lw=0.8)
     axes[2].text(1e4, 25, "this machine: 24 GiB", color="grey", fontsize=8)
-    for ax, title, unit in zip(axes, ("remesh and first step", "flow step", "peak RSS of the engine"),
-                               ("s", "ms", "GiB")):
+    for ax, title, unit in zip(
+        axes, ("remesh and first step", "flow step", "peak RSS of the engine"), ("s", "ms", "GiB")
+    ):
         ax.set_title(title)
         ax.set_xlabel("spheres N")
         ax.set_ylabel(unit)
@@ -320,7 +387,7 @@ def write_between_markers(path, text):
     old = open(path).read() if os.path.exists(path) else ""
     block = f"{BEGIN_MARK}\n\n{text}\n{END_MARK}"
     if BEGIN_MARK in old and END_MARK in old:
-        new = old[:old.index(BEGIN_MARK)] + block + old[old.index(END_MARK) + len(END_MARK):]
+        new = old[: old.index(BEGIN_MARK)] + block + old[old.index(END_MARK) + len(END_MARK) :]
     else:
         new = old + ("\n" if old else "") + block + "\n"
     with open(path, "w") as f:
@@ -336,13 +403,17 @@ def driver(o):
             data = json.load(f)
     else:
         plan = [(int(float(s)), KINDS) for s in o["sizes"].split(",") if s]
-        plan += [(int(float(s.split(":")[0])), KINDS[2:] if s.endswith(":mg") else KINDS[1:])
-                 for s in o["pfv_sizes"].split(",") if s]
+        plan += [
+            (int(float(s.split(":")[0])), KINDS[2:] if s.endswith(":mg") else KINDS[1:])
+            for s in o["pfv_sizes"].split(",")
+            if s
+        ]
         data = dict(blocks=blocks, timing=[], memory=[])
         for n, kinds in plan:
             print(f"growth: N = {n}: timing {', '.join(kinds)}", flush=True)
-            data["timing"].append(run_child(["--child=time", f"--n={n}", f"--kinds={','.join(kinds)}",
-                                             f"--blocks={blocks}"]))
+            data["timing"].append(
+                run_child(["--child=time", f"--n={n}", f"--kinds={','.join(kinds)}", f"--blocks={blocks}"])
+            )
             for kind in kinds:
                 print(f"growth: N = {n}: memory of {kind}", flush=True)
                 data["memory"].append(run_child(["--child=memory", f"--n={n}", f"--kinds={kind}"]))

@@ -43,8 +43,13 @@ def run(steps, mixed, tolerance=None):
         change.append(np.abs(p - previous).max() / np.abs(p).max())
         history.append(p)
         previous = p
-    result = dict(solve=float(np.median(solve)), passes=np.bincount(passes).tolist(),
-                  contraction=core.refinement_contraction(), change=float(np.median(change)), history=history)
+    result = dict(
+        solve=float(np.median(solve)),
+        passes=np.bincount(passes).tolist(),
+        contraction=core.refinement_contraction(),
+        change=float(np.median(change)),
+        history=history,
+    )
     O.engines = O.engines[:1]
     return result
 
@@ -57,13 +62,17 @@ def main():
     O.saveTmp('bench')
     reference = run(steps, False)
     print('N = %d, %d steps, %d thread(s)' % (n, steps, O.numThreads))
-    print('double factor: solve %.2f ms (median), pressure change per step %.2g of max|p|'
-          % (1e3 * reference['solve'], reference['change']))
+    print(
+        'double factor: solve %.2f ms (median), pressure change per step %.2g of max|p|'
+        % (1e3 * reference['solve'], reference['change'])
+    )
     for tol in tolerances:
         r = run(steps, True, tol)
         diff = max(np.abs(a - b).max() / np.abs(b).max() for a, b in zip(r['history'], reference['history']))
-        print('mixed, refinement_tolerance %.0e: solve %.2f ms, steps with 0/1/2/... passes %s, contraction %.2g, '
-              'max |p - p_double| / max|p| %.1e' % (tol, 1e3 * r['solve'], r['passes'], r['contraction'], diff))
+        print(
+            'mixed, refinement_tolerance %.0e: solve %.2f ms, steps with 0/1/2/... passes %s, contraction %.2g, '
+            'max |p - p_double| / max|p| %.1e' % (tol, 1e3 * r['solve'], r['passes'], r['contraction'], diff)
+        )
 
 
 main()

@@ -35,9 +35,12 @@ from pfv_testing.lattice import lattice_permeameter
 
 SMOOTHERS = ("gauss_seidel", "split_gauss_seidel", "jacobi")
 # name, strain of the squeeze after k steps, random displacement per step in radii, steps
-PHASES = (("static", lambda k: 0.0, 0.0, 10), ("squeeze", lambda k: 2e-5 * k, 0.0, 6),
-          ("jerky squeeze", lambda k: 1e-11 * k ** 3, 0.0, 6),
-          ("random motion", lambda k: 0.0, 1e-4, 6))
+PHASES = (
+    ("static", lambda k: 0.0, 0.0, 10),
+    ("squeeze", lambda k: 2e-5 * k, 0.0, 6),
+    ("jerky squeeze", lambda k: 1e-11 * k**3, 0.0, 6),
+    ("random motion", lambda k: 0.0, 1e-4, 6),
+)
 DT = 1e-4
 
 
@@ -80,22 +83,30 @@ def main(argv):
             k = r % len(SMOOTHERS)
             for s in SMOOTHERS[k:] + SMOOTHERS[:k]:
                 results[s].append(turn(e, pos, rad, walls, s))
-        print(f"N = {n:,} spheres, {e.n_cells():,} cells, {rounds} rounds (`multigrid_smoothers.py {n} "
-              f"--rounds={rounds}`)\n")
-        print("| phase | smoother | solve [ms], median per round | step [ms], median | CG iterations | "
-              "solve / Gauss-Seidel's, per round |")
+        print(
+            f"N = {n:,} spheres, {e.n_cells():,} cells, {rounds} rounds (`multigrid_smoothers.py {n} "
+            f"--rounds={rounds}`)\n"
+        )
+        print(
+            "| phase | smoother | solve [ms], median per round | step [ms], median | CG iterations | "
+            "solve / Gauss-Seidel's, per round |"
+        )
         print("|---|---|---|---|---|---|")
         for name, *_ in PHASES:
             for s in SMOOTHERS:
-                ratio = [statistics.median(t[name][0]) / statistics.median(g[name][0])
-                         for t, g in zip(results[s], results["gauss_seidel"])]
+                ratio = [
+                    statistics.median(t[name][0]) / statistics.median(g[name][0])
+                    for t, g in zip(results[s], results["gauss_seidel"])
+                ]
                 solve = [1e3 * statistics.median(t[name][0]) for t in results[s]]
                 step = 1e3 * statistics.median([x for t in results[s] for x in t[name][1]])
                 its = sorted({i for t in results[s] for i in t[name][2]})
                 its_text = str(its[0]) if len(its) == 1 else f"{its[0]}–{its[-1]}"
                 ratio_text = ", ".join(f"{x:.2f}" for x in ratio) if s != "gauss_seidel" else ""
-                print(f"| {name} | {s} | {', '.join(f'{x:.0f}' for x in solve)} | {step:.0f} | {its_text} | "
-                      f"{ratio_text} |")
+                print(
+                    f"| {name} | {s} | {', '.join(f'{x:.0f}' for x in solve)} | {step:.0f} | {its_text} | "
+                    f"{ratio_text} |"
+                )
         print(flush=True)
     return 0
 

@@ -53,8 +53,11 @@ def main():
         if i == steps // 10:
             rss_ref = rss_mb()
         if i % every == 0 or i == steps - 1:
-            print(f"step {i:6d}  RSS {rss_mb():8.1f} MB  remeshes {engine.remesh_count:5d}  "
-                  f"worst conservation error {worst:.2e}", flush=True)
+            print(
+                f"step {i:6d}  RSS {rss_mb():8.1f} MB  remeshes {engine.remesh_count:5d}  "
+                f"worst conservation error {worst:.2e}",
+                flush=True,
+            )
     growth = rss_mb() - rss_ref
     print(f"RSS growth after the first tenth: {growth:.2f} MB; worst conservation error {worst:.2e}")
     ok = growth <= max_growth and worst <= max_error

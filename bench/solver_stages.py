@@ -63,7 +63,7 @@ def engine(mixed=False, reuse=True):
     e.bnd_value = [0, 0, 100.0, 0, 0, 0]
     e.viscosity = 1e-3
     e.slip_boundary = False
-    e.mesh_update_interval = 10 ** 9
+    e.mesh_update_interval = 10**9
     e.mixed_precision = mixed
     e.mixed_precision_min_entries = 0  # with mixed: the 32-bit factor whatever the size
     e.reuse_ordering = reuse
@@ -83,10 +83,19 @@ def ordering(pos, rad, walls):
         old = set(tuple(sorted(c)) for c in np.asarray(engine_cells(pos, rad, walls)).tolist())
         new = [tuple(sorted(c)) for c in np.asarray(reused.cell_vertices()).tolist()]
         share_new = sum(c not in old for c in new) / len(new)
-        print('   moved by %.1f %% of a radius (%.1f %% new cells): fresh analysis %.3f s, fill %.1f; carried over: '
-              'analysis %.3f s, fill %.1f, kept %s'
-              % (100 * amplitude, 100 * share_new, fresh.remesh_times()['analysis'], fresh.factor_fill(),
-                 reused.remesh_times()['analysis'], reused.factor_fill(), reused.ordering_reused()))
+        print(
+            '   moved by %.1f %% of a radius (%.1f %% new cells): fresh analysis %.3f s, fill %.1f; carried over: '
+            'analysis %.3f s, fill %.1f, kept %s'
+            % (
+                100 * amplitude,
+                100 * share_new,
+                fresh.remesh_times()['analysis'],
+                fresh.factor_fill(),
+                reused.remesh_times()['analysis'],
+                reused.factor_fill(),
+                reused.ordering_reused(),
+            )
+        )
 
 
 def engine_cells(pos, rad, walls):
@@ -96,11 +105,13 @@ def engine_cells(pos, rad, walls):
 
 
 def mixed_precision(pos, rad, walls):
-    print('2. mixed precision, the factor in cache (a loop of solves) and evicted before each solve (a 256 MB buffer '
-          'written in between, as the DEM does in a run)')
+    print(
+        '2. mixed precision, the factor in cache (a loop of solves) and evicted before each solve (a 256 MB buffer '
+        'written in between, as the DEM does in a run)'
+    )
     rng = np.random.default_rng(2)
     vel = rng.normal(0, 1e-3, pos.shape)
-    evictor = np.zeros(32 * 2 ** 20)
+    evictor = np.zeros(32 * 2**20)
     for evict in (False, True):
         result = {}
         for mixed in (False, True):
@@ -113,9 +124,16 @@ def mixed_precision(pos, rad, walls):
                 times.append(e.step_times()['solve'])
                 pressures.append(e.pressure())
             result[mixed] = pressures
-            print('   %s, %s: solve %s (steps 4-30), passes at the last step %d, contraction %.2g'
-                  % ('evicted ' if evict else 'in cache', 'mixed ' if mixed else 'double', stats(times[3:]),
-                     e.refinement_passes, e.refinement_contraction()))
+            print(
+                '   %s, %s: solve %s (steps 4-30), passes at the last step %d, contraction %.2g'
+                % (
+                    'evicted ' if evict else 'in cache',
+                    'mixed ' if mixed else 'double',
+                    stats(times[3:]),
+                    e.refinement_passes,
+                    e.refinement_contraction(),
+                )
+            )
         diff = max(np.abs(a - b).max() / np.abs(b).max() for a, b in zip(result[True], result[False]))
         print('   largest |p_mixed - p_double| / max|p| over the 30 steps: %.2g' % diff)
 
@@ -141,8 +159,10 @@ def exchange(pos, rad, L):
         for i in range(n):
             add(i, tuples[i])
         t_tuples.append(time.perf_counter() - t0)
-    print('   bridge (in place: %s): %s; addF with tuples from Python: %s'
-          % (bridge.writes_in_place, stats(t_bridge), stats(t_tuples)))
+    print(
+        '   bridge (in place: %s): %s; addF with tuples from Python: %s'
+        % (bridge.writes_in_place, stats(t_bridge), stats(t_tuples))
+    )
     print('4. positions read, %d bodies' % n)
     read = yade._utils.coordsAndDisplacements
     together, apart = [], []
@@ -167,8 +187,9 @@ def exchange(pos, rad, L):
         pfv._core.gather_sphere_pack(pack, index, centres)
         packed.append(time.perf_counter() - t0)
     print('   three lists alive together: %s; one axis at a time: %s' % (stats(together), stats(apart)))
-    print('   SpherePack.fromSimulation(): %s; with the in-place read of its centres: %s'
-          % (stats(fill), stats(packed)))
+    print(
+        '   SpherePack.fromSimulation(): %s; with the in-place read of its centres: %s' % (stats(fill), stats(packed))
+    )
 
 
 def remesh_sequence(n):
@@ -187,9 +208,15 @@ def remesh_sequence(n):
         O.step()
         faults = resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults
         t = core.remesh_times()
-        print('   mesh %d, %s: %s; %d page faults' % (
-            core.remesh_count, "PFV's numeric factorisation" if serial else "CHOLMOD's, in its teams of 4",
-            ', '.join('%s %.1f ms' % (k, 1e3 * t[k]) for k in keys), faults))
+        print(
+            '   mesh %d, %s: %s; %d page faults'
+            % (
+                core.remesh_count,
+                "PFV's numeric factorisation" if serial else "CHOLMOD's, in its teams of 4",
+                ', '.join('%s %.1f ms' % (k, 1e3 * t[k]) for k in keys),
+                faults,
+            )
+        )
     O.engines = O.engines[:1]
 
 
@@ -200,7 +227,7 @@ def collective_limit(pos, rad, walls):
     e.viscosity = 10.0
     for _ in range(2):  # the operator is linearised about the previous step's positions
         e.step(pos, rad, walls, 1e-4)
-    mass = 2600 * 4 / 3 * np.pi * rad ** 3
+    mass = 2600 * 4 / 3 * np.pi * rad**3
     t0 = time.perf_counter()
     arnoldi = e.viscous_stability_limit(mass, 40)
     t_arnoldi = time.perf_counter() - t0
@@ -212,28 +239,42 @@ def collective_limit(pos, rad, walls):
         limit, mode, _ = e.viscous_stability_mode(mass, 3, mode)
         power.append(limit)
     t_power = (time.perf_counter() - t0) / 3  # per 40 iterations
-    print('   Arnoldi %.7g s in %.3f s; power iteration: %.7g after 39 iterations (%.3f s), %.7g after 120; '
-          'power-39 / Arnoldi - 1 = %.2g'
-          % (arnoldi, t_arnoldi, power[12], t_power, power[-1], power[12] / arnoldi - 1))
-    for name, method in (('global bound (what the time-step guard asks first)', e.viscous_stability_bound),
-                         ('local bound', e.viscous_stability_local_bound)):
+    print(
+        '   Arnoldi %.7g s in %.3f s; power iteration: %.7g after 39 iterations (%.3f s), %.7g after 120; '
+        'power-39 / Arnoldi - 1 = %.2g' % (arnoldi, t_arnoldi, power[12], t_power, power[-1], power[12] / arnoldi - 1)
+    )
+    for name, method in (
+        ('global bound (what the time-step guard asks first)', e.viscous_stability_bound),
+        ('local bound', e.viscous_stability_local_bound),
+    ):
         times = []
         for _ in range(3):
             t0 = time.perf_counter()
             bound = method(mass)
             times.append(time.perf_counter() - t0)
-        print('   certified %s %.4g s = %.3g x Arnoldi\'s limit, in %.3f s (min of 3; the first %.3f s)'
-              % (name, bound, bound / arnoldi, min(times), times[0]))
+        print(
+            '   certified %s %.4g s = %.3g x Arnoldi\'s limit, in %.3f s (min of 3; the first %.3f s)'
+            % (name, bound, bound / arnoldi, min(times), times[0])
+        )
 
 
 def ordering_threshold(pos, rad, L, repeats=3):
     """Section 7: the first ordering of sub-cubes of the packing: AMD alone, METIS alone, the geometric nested
     dissection and CHOLMOD's rule."""
-    print('7. first ordering against the size (medians of %d fresh engines each; the solve: the double factor)'
-          % repeats)
-    print('   %8s %8s | %-38s | %-38s | %-38s | %-24s'
-          % ('spheres', 'unknowns', 'AMD: analysis, factor, nnz(L), solve', 'METIS: analysis, factor, nnz(L), solve',
-             'geometric: analysis, factor, nnz(L), solve', "CHOLMOD's rule: analysis, kept"))
+    print(
+        '7. first ordering against the size (medians of %d fresh engines each; the solve: the double factor)' % repeats
+    )
+    print(
+        '   %8s %8s | %-38s | %-38s | %-38s | %-24s'
+        % (
+            'spheres',
+            'unknowns',
+            'AMD: analysis, factor, nnz(L), solve',
+            'METIS: analysis, factor, nnz(L), solve',
+            'geometric: analysis, factor, nnz(L), solve',
+            "CHOLMOD's rule: analysis, kept",
+        )
+    )
     for target in (1000, 2000, 3000, 4000, 8000, 16000, 32000, 64000):
         if target > 1.2 * len(rad):
             break
@@ -249,16 +290,20 @@ def ordering_threshold(pos, rad, L, repeats=3):
                 e.step(p, r, walls, 1e-4)
                 t = e.remesh_times()
                 e.step(p, r, walls, 1e-4)
-                runs.append((t['analysis'], t['factorization'], e.factor_nonzeros(), e.step_times()['solve'],
-                             e.metis_used()))
+                runs.append(
+                    (t['analysis'], t['factorization'], e.factor_nonzeros(), e.step_times()['solve'], e.metis_used())
+                )
                 unknowns = e.n_unknowns()
             row[name] = [float(np.median([x[k] for x in runs])) for k in range(4)] + [{x[4] for x in runs}]
         kept = '/'.join(sorted('METIS' if m else 'AMD' for m in row['cholmod'][4]))
-        cells = ' | '.join('%7.3f s %7.3f s %8.3g %6.2f ms' % (*row[k][:3], 1e3 * row[k][3])
-                           for k in ('amd', 'metis', 'geometric'))
+        cells = ' | '.join(
+            '%7.3f s %7.3f s %8.3g %6.2f ms' % (*row[k][:3], 1e3 * row[k][3]) for k in ('amd', 'metis', 'geometric')
+        )
         print('   %8d %8d | %s | %7.3f s  %s' % (len(r), unknowns, cells, row['cholmod'][0], kept))
-    print('   ordering="auto" is CHOLMOD\'s rule below %d unknowns and the geometric nested dissection from there on'
-          % pfv.Engine.geometric_from)
+    print(
+        '   ordering="auto" is CHOLMOD\'s rule below %d unknowns and the geometric nested dissection from there on'
+        % pfv.Engine.geometric_from
+    )
 
 
 def first_touch(pos, rad, walls):
@@ -285,8 +330,10 @@ def first_touch(pos, rad, walls):
         np.core.multiarray._set_madvise_hugepage(huge)
     for advise, pages in ((False, '4 kB pages'), (True, 'huge pages')):
         r = rates[advise]
-        print('   %s: first write %s GB/s, second %s GB/s' % (
-            pages, ', '.join('%.2f' % x[0] for x in r), ', '.join('%.1f' % x[1] for x in r)))
+        print(
+            '   %s: first write %s GB/s, second %s GB/s'
+            % (pages, ', '.join('%.2f' % x[0] for x in r), ', '.join('%.1f' % x[1] for x in r))
+        )
 
 
 def parallel_ordering(pos, rad, walls, repeats=5):
@@ -306,8 +353,10 @@ def parallel_ordering(pos, rad, walls, repeats=5):
     finally:
         pfv.set_num_threads(threads)
     for t in (1, 2):
-        print('   %d thread%s: analysis %s; nnz(L) %s' % (t, 's' if t > 1 else '', stats(analysis[t]),
-                                                          ', '.join('%d' % x for x in sorted(entries[t]))))
+        print(
+            '   %d thread%s: analysis %s; nnz(L) %s'
+            % (t, 's' if t > 1 else '', stats(analysis[t]), ', '.join('%d' % x for x in sorted(entries[t])))
+        )
     print('   two threads / one (medians): %.2f' % (np.median(analysis[2]) / np.median(analysis[1])))
 
 

@@ -75,10 +75,10 @@ PACKING_VERSION = 1
 PHI = 0.58
 VISCOSITY = 1.0
 DT = 1e-3
-SAMPLE = 5                  # oedometer: slice pressure and forces every SAMPLE steps
-SOLVER_INTERVAL = 100       # oedometer: remesh interval of the solver sweeps
+SAMPLE = 5  # oedometer: slice pressure and forces every SAMPLE steps
+SOLVER_INTERVAL = 100  # oedometer: remesh interval of the solver sweeps
 TOLS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
-MULTIGRID = 4               # the solver code of solver='multigrid' here (YADE has no number for it)
+MULTIGRID = 4  # the solver code of solver='multigrid' here (YADE has no number for it)
 # multigrid: refinement_tolerance, relative to the pressure spread (permeameter: all; oedometers: every other)
 AMG_TOLS = [1e-4, 1e-6, 1e-8, 1e-10]
 # scene: (steps, eps_f, tau as a fraction of steps)
@@ -106,10 +106,11 @@ def packing(n, work, seed=1, iters=300):
         d = np.load(path)
         return d[:, :3].copy(), d[:, 3].copy()
     from scipy.spatial import cKDTree
+
     rng = np.random.default_rng(seed)
     side = (n / 1000) ** (1 / 3)
     r0 = rng.uniform(0.8, 1.2, n)
-    r = r0 * (PHI * side ** 3 / (4 / 3 * np.pi * np.sum(r0 ** 3))) ** (1 / 3)
+    r = r0 * (PHI * side**3 / (4 / 3 * np.pi * np.sum(r0**3))) ** (1 / 3)
     x = rng.uniform(0, side, (n, 3))
     x = np.clip(x, r[:, None], side - r[:, None])
     rmax = r.max()
@@ -139,17 +140,22 @@ def solver_iterations(e):
 
 def packing_stats(x, r):
     from scipy.spatial import cKDTree
+
     side = (len(r) / 1000) ** (1 / 3)
     pairs = cKDTree(x).query_pairs(2 * r.max(), output_type='ndarray')
     ov = r[pairs[:, 0]] + r[pairs[:, 1]] - np.linalg.norm(x[pairs[:, 1]] - x[pairs[:, 0]], axis=1)
-    return {'side': side, 'porosity': 1 - np.sum(4 / 3 * np.pi * r ** 3) / side ** 3,
-            'max_overlap_over_r': float(np.max(ov / np.minimum(r[pairs[:, 0]], r[pairs[:, 1]]))),
-            'mean_diameter': float(2 * r.mean())}
+    return {
+        'side': side,
+        'porosity': 1 - np.sum(4 / 3 * np.pi * r**3) / side**3,
+        'max_overlap_over_r': float(np.max(ov / np.minimum(r[pairs[:, 0]], r[pairs[:, 1]]))),
+        'mean_diameter': float(2 * r.mean()),
+    }
 
 
 # ---------------------------------------------------------------------------------------------------------- engines
-def make_engine(pfv, solver=3, tol=1e-6, interval=1, def_tol=0.0, background=False, drained=(True, True),
-                mixed=False, ref_tol=None):
+def make_engine(
+    pfv, solver=3, tol=1e-6, interval=1, def_tol=0.0, background=False, drained=(True, True), mixed=False, ref_tol=None
+):
     e = pfv.Engine()
     e.mixed_precision = mixed
     e.mixed_precision_min_entries = 0  # with mixed: the 32-bit factor at the study's sizes too
@@ -175,9 +181,17 @@ def solver_name(s):
 def perm_configs(quick):
     tols = TOLS[::2] if quick else TOLS
     cfgs = [dict(name='CHOLMOD', family='CHOLMOD', solver=3, tol=0.0)]
-    cfgs += [dict(name='CHOLMOD mixed precision', family='mixed', solver=3, tol=0.0, mixed=True),
-             dict(name='CHOLMOD mixed precision, refinement 1e-06', family='mixed', solver=3, tol=0.0, mixed=True,
-                  ref_tol=1e-6)]
+    cfgs += [
+        dict(name='CHOLMOD mixed precision', family='mixed', solver=3, tol=0.0, mixed=True),
+        dict(
+            name='CHOLMOD mixed precision, refinement 1e-06',
+            family='mixed',
+            solver=3,
+            tol=0.0,
+            mixed=True,
+            ref_tol=1e-6,
+        ),
+    ]
     cfgs += [dict(name=f'GS {t:.0e}', family='GS', solver=0, tol=t) for t in tols]
     cfgs += [dict(name=f'PCG {t:.0e}', family='PCG', solver=1, tol=t) for t in tols]
     cfgs += [dict(name=f'AMG-PCG {t:.0e}', family='AMG-PCG', solver=MULTIGRID, tol=t) for t in AMG_TOLS]
@@ -188,26 +202,49 @@ def oedo_configs(scene, n, quick):
     c = [dict(name='reference (CHOLMOD, remesh every step)', family='reference', solver=3, interval=1)]
     ints = [10, 100, 1000, 5000]
     c += [dict(name=f'CHOLMOD, interval {i}', family='interval', solver=3, interval=i) for i in ints]
-    c += [dict(name=f'CHOLMOD, defTolerance {d:g}', family='defTolerance', solver=3, interval=0, def_tol=d)
-          for d in (0.001, 0.01, 0.1)]
+    c += [
+        dict(name=f'CHOLMOD, defTolerance {d:g}', family='defTolerance', solver=3, interval=0, def_tol=d)
+        for d in (0.001, 0.01, 0.1)
+    ]
     si = SOLVER_INTERVAL if scene == 'slow' else 10
     # Tight tolerances of the iterative solvers cost up to seconds per step on the large packing: there the sweep is
     # thinned (the small packing has the full one, and the permeameter every decade at both sizes).
     tols = SOLVER_TOLS[(scene, 'quick' if quick else ('large' if n >= 4000 else 'small'))]
     for s in (0, 1):
-        c += [dict(name=f'{solver_name(s)} {t:.0e}, interval {si}', family=solver_name(s), solver=s, tol=t,
-                   interval=si) for t in tols[s]]
-    c += [dict(name=f'AMG-PCG {t:.0e}, interval {si}', family='AMG-PCG', solver=MULTIGRID, tol=t, interval=si)
-          for t in AMG_TOLS[1::2]]
-    c += [dict(name='CHOLMOD mixed precision, interval 10', family='mixed', solver=3, interval=10, mixed=True),
-          dict(name='CHOLMOD mixed precision, refinement 1e-06, interval 10', family='mixed', solver=3, interval=10,
-               mixed=True, ref_tol=1e-6),
-          dict(name='CHOLMOD mixed precision, defTolerance 0.01', family='mixed', solver=3, interval=0,
-               def_tol=0.01, mixed=True)]
+        c += [
+            dict(name=f'{solver_name(s)} {t:.0e}, interval {si}', family=solver_name(s), solver=s, tol=t, interval=si)
+            for t in tols[s]
+        ]
+    c += [
+        dict(name=f'AMG-PCG {t:.0e}, interval {si}', family='AMG-PCG', solver=MULTIGRID, tol=t, interval=si)
+        for t in AMG_TOLS[1::2]
+    ]
+    c += [
+        dict(name='CHOLMOD mixed precision, interval 10', family='mixed', solver=3, interval=10, mixed=True),
+        dict(
+            name='CHOLMOD mixed precision, refinement 1e-06, interval 10',
+            family='mixed',
+            solver=3,
+            interval=10,
+            mixed=True,
+            ref_tol=1e-6,
+        ),
+        dict(
+            name='CHOLMOD mixed precision, defTolerance 0.01',
+            family='mixed',
+            solver=3,
+            interval=0,
+            def_tol=0.01,
+            mixed=True,
+        ),
+    ]
     c += [dict(name='CHOLMOD, interval 10, background', family='background', solver=3, interval=10, background=True)]
     if scene == 'slow' and n < 4000:
-        c += [dict(name=f'CHOLMOD, interval {si}, background', family='background', solver=3, interval=si,
-                   background=True)]
+        c += [
+            dict(
+                name=f'CHOLMOD, interval {si}, background', family='background', solver=3, interval=si, background=True
+            )
+        ]
     return c
 
 
@@ -222,12 +259,18 @@ def run_perm(pfv, n, work, rounds, quick):
     ref = None
     res = {c['name']: dict(c, first=[], step=[], iters_first=None, iters_steady=[]) for c in cfgs}
     for rnd in range(rounds):
-        order = cfgs[rnd % len(cfgs):] + cfgs[:rnd % len(cfgs)]
+        order = cfgs[rnd % len(cfgs) :] + cfgs[: rnd % len(cfgs)]
         if ref is None:  # the reference runs first in round 0: its results are needed by the others
             order = [cfgs[0]] + [c for c in order if c is not cfgs[0]]
         for c in order:
-            e = make_engine(pfv, solver=c['solver'], tol=c['tol'] or 1e-6, interval=0, mixed=c.get('mixed', False),
-                            ref_tol=c.get('ref_tol'))
+            e = make_engine(
+                pfv,
+                solver=c['solver'],
+                tol=c['tol'] or 1e-6,
+                interval=0,
+                mixed=c.get('mixed', False),
+                ref_tol=c.get('ref_tol'),
+            )
             rec = res[c['name']]
             times, errs = [], []
             for k, p in enumerate(p_in):
@@ -242,10 +285,15 @@ def run_perm(pfv, n, work, rounds, quick):
                         ref = ref or []
                         ref.append((q_in, pr, f))
                     rq, rp, rf = ref[k]
-                    errs.append(dict(g_error=abs(q_in + q_out) / abs(q_in), q_error=abs(q_in - rq) / abs(rq),
-                                     p_error=float(np.max(np.abs(pr - rp))) / p,
-                                     f_error=float(np.linalg.norm(f - rf) / np.linalg.norm(rf)),
-                                     iters=solver_iterations(e)))
+                    errs.append(
+                        dict(
+                            g_error=abs(q_in + q_out) / abs(q_in),
+                            q_error=abs(q_in - rq) / abs(rq),
+                            p_error=float(np.max(np.abs(pr - rp))) / p,
+                            f_error=float(np.linalg.norm(f - rf) / np.linalg.norm(rf)),
+                            iters=solver_iterations(e),
+                        )
+                    )
             rec['first'].append(times[0])
             rec['step'].append(float(np.median(times[1:])))
             if rnd == 0:
@@ -254,17 +302,43 @@ def run_perm(pfv, n, work, rounds, quick):
                 rec['iters_first'] = errs[0]['iters']
                 rec['iters_steady'] = float(np.mean([er['iters'] for er in errs[1:]]))
                 rec['n_cells'] = e.n_cells()
-            log(f'perm n={n} round {rnd} {c["name"]}: first {times[0]*1e3:.1f} ms, '
-                f'step {np.median(times[1:])*1e3:.2f} ms')
+            log(
+                f'perm n={n} round {rnd} {c["name"]}: first {times[0]*1e3:.1f} ms, '
+                f'step {np.median(times[1:])*1e3:.2f} ms'
+            )
             del e
     for rec in res.values():
         rec['first_median'] = float(np.median(rec['first']))
         rec['step_median'] = float(np.median(rec['step']))
-    return dict(scene='perm', n=n, steady_steps=steady, rounds=rounds, packing=packing_stats(x, r),
-                configs=list(res.values()))
+    return dict(
+        scene='perm', n=n, steady_steps=steady, rounds=rounds, packing=packing_stats(x, r), configs=list(res.values())
+    )
 
 
 # ---------------------------------------------------------------------------------------------------------- oedometer
+def record_step(engines, k, n, box, out):
+    """After step k: each engine's base stress, flux balance (from the second step), and every SAMPLE steps its
+    mid-height pressure and its sphere forces' distance to the reference's (engine 0), into the arrays of `out`."""
+    side, height = box
+    f_ref = None
+    for j, e in enumerate(engines):
+        f = e.forces()
+        out['base'][j, k] = -f[n + 2, 1] / (side * side)
+        if k > 0:
+            q, v = e.boundary_flux(3), e.volume_rate_total()
+            out['cons'][j] += (abs(q + v), abs(v))
+        if k % SAMPLE == 0:
+            out['mid'][j, k // SAMPLE] = e.average_slice_pressure(1, height / 2)
+            if j == 0:
+                f_ref = f[:n].copy()
+            out['ferr'][j, k // SAMPLE] = np.linalg.norm(f[:n] - f_ref) / max(np.linalg.norm(f_ref), 1e-300)
+
+
+def schedule(c):
+    """The remesh schedule of a configuration: (interval, defTolerance)."""
+    return (c['interval'], c.get('def_tol', 0.0))
+
+
 def run_oedo(pfv, scene, n, work, quick):
     x0, r = packing(n, work)
     side = (n / 1000) ** (1 / 3)
@@ -274,9 +348,20 @@ def run_oedo(pfv, scene, n, work, quick):
     rng = np.random.default_rng(12345)
     delta = np.clip(rng.normal(0, d, x0.shape), -3 * d, 3 * d)
     cfgs = oedo_configs(scene, n, quick)
-    engines = [make_engine(pfv, solver=c['solver'], tol=c.get('tol', 1e-6), interval=c['interval'],
-                           def_tol=c.get('def_tol', 0.0), background=c.get('background', False),
-                           drained=(False, True), mixed=c.get('mixed', False), ref_tol=c.get('ref_tol')) for c in cfgs]
+    engines = [
+        make_engine(
+            pfv,
+            solver=c['solver'],
+            tol=c.get('tol', 1e-6),
+            interval=c['interval'],
+            def_tol=c.get('def_tol', 0.0),
+            background=c.get('background', False),
+            drained=(False, True),
+            mixed=c.get('mixed', False),
+            ref_tol=c.get('ref_tol'),
+        )
+        for c in cfgs
+    ]
     nc = len(cfgs)
     cpu = np.zeros((nc, steps))
     remeshed = np.zeros((nc, steps), bool)
@@ -293,7 +378,6 @@ def run_oedo(pfv, scene, n, work, quick):
         x = x0 + eps * delta
         x[:, 1] = x0[:, 1] * (1 - eps) + eps * delta[:, 1]
         walls = [0, side, 0, height, 0, side]
-        f_ref = None
         order = [0] + [j for j in [(k + i) % nc for i in range(nc)] if j != 0]
         if k % 2:  # rotate the reference's position too
             order = order[1:] + order[:1]
@@ -310,17 +394,7 @@ def run_oedo(pfv, scene, n, work, quick):
             else:
                 remeshed[j, k] = e.remesh_count != before
             iters[j, k] = solver_iterations(e)
-        for j, e in enumerate(engines):
-            f = e.forces()
-            base[j, k] = -f[n + 2, 1] / (side * side)
-            if k > 0:
-                q, v = e.boundary_flux(3), e.volume_rate_total()
-                cons[j] += (abs(q + v), abs(v))
-            if k % SAMPLE == 0:
-                mid[j, k // SAMPLE] = e.average_slice_pressure(1, height / 2)
-                if j == 0:
-                    f_ref = f[:n].copy()
-                ferr[j, k // SAMPLE] = np.linalg.norm(f[:n] - f_ref) / max(np.linalg.norm(f_ref), 1e-300)
+        record_step(engines, k, n, (side, height), dict(base=base, cons=cons, mid=mid, ferr=ferr))
         strain_max = max(strain_max, eps_f / tau * math.exp(-k / tau))
         if k % max(1, steps // 10) == 0:
             log(f'{scene} n={n} step {k}/{steps} ({time.time() - t_wall:.0f} s)')
@@ -328,30 +402,43 @@ def run_oedo(pfv, scene, n, work, quick):
     out = []
     for j, c in enumerate(cfgs):
         rec = dict(c)
-        rec.update(cost=float(cpu[j].sum() / steps), remeshes=int(remeshed[j].sum()),
-                   remesh_cpu=float(cpu[j][remeshed[j]].sum() / steps),
-                   step_cpu_median=float(np.median(cpu[j][~remeshed[j]])) if (~remeshed[j]).any() else None,
-                   iters_mean=float(iters[j].mean()), iters_max=float(iters[j].max()),
-                   e_base=float(np.sqrt(np.mean((base[j] - base[0]) ** 2)) / pb),
-                   e_base_max=float(np.max(np.abs(base[j] - base[0])) / pb),
-                   e_mid=float(np.sqrt(np.mean((mid[j] - mid[0]) ** 2)) / pm),
-                   e_force=float(np.sqrt(np.mean(ferr[j] ** 2))),
-                   conservation=float(cons[j, 0] / cons[j, 1]),
-                   n_cells=engines[j].n_cells())
+        rec.update(
+            cost=float(cpu[j].sum() / steps),
+            remeshes=int(remeshed[j].sum()),
+            remesh_cpu=float(cpu[j][remeshed[j]].sum() / steps),
+            step_cpu_median=float(np.median(cpu[j][~remeshed[j]])) if (~remeshed[j]).any() else None,
+            iters_mean=float(iters[j].mean()),
+            iters_max=float(iters[j].max()),
+            e_base=float(np.sqrt(np.mean((base[j] - base[0]) ** 2)) / pb),
+            e_base_max=float(np.max(np.abs(base[j] - base[0])) / pb),
+            e_mid=float(np.sqrt(np.mean((mid[j] - mid[0]) ** 2)) / pm),
+            e_force=float(np.sqrt(np.mean(ferr[j] ** 2))),
+            conservation=float(cons[j, 0] / cons[j, 1]),
+            n_cells=engines[j].n_cells(),
+        )
         out.append(rec)
 
     # Pure solver error: each solver run against the double CHOLMOD on the same remesh schedule.
-    def schedule(c):
-        return (c['interval'], c.get('def_tol', 0.0))
-    by_schedule = {schedule(c): j for j, c in enumerate(cfgs)
-                   if c['family'] in ('interval', 'defTolerance', 'reference')}
+    by_schedule = {
+        schedule(c): j for j, c in enumerate(cfgs) if c['family'] in ('interval', 'defTolerance', 'reference')
+    }
     for j, c in enumerate(cfgs):
         if c['family'] in ('GS', 'PCG', 'AMG-PCG', 'mixed') and schedule(c) in by_schedule:
             b = by_schedule[schedule(c)]
             out[j]['e_base_same_mesh'] = float(np.sqrt(np.mean((base[j] - base[b]) ** 2)) / pb)
-    return dict(scene=scene, n=n, steps=steps, eps_f=eps_f, tau=tau, max_strain_rate_per_step=strain_max,
-                packing=packing_stats(x0, r), p_base_peak=float(pb), p_mid_peak=float(pm),
-                history=dict(base_ref=base[0][::max(1, steps // 200)].tolist()), configs=out)
+    return dict(
+        scene=scene,
+        n=n,
+        steps=steps,
+        eps_f=eps_f,
+        tau=tau,
+        max_strain_rate_per_step=strain_max,
+        packing=packing_stats(x0, r),
+        p_base_peak=float(pb),
+        p_mid_peak=float(pm),
+        history=dict(base_ref=base[0][:: max(1, steps // 200)].tolist()),
+        configs=out,
+    )
 
 
 # ---------------------------------------------------------------------------------------------------------- report
@@ -377,58 +464,89 @@ def fmt(x, digits=2):
 def report(parts, command, quick):
     L = []
     perm = sorted([p for p in parts if p['scene'] == 'perm'], key=lambda p: p['n'])
-    L.append(f'Produced by `{command}`'
-             + (' (quick mode: smaller sizes, fewer steps; not for decisions)' if quick else '') + '.')
+    L.append(
+        f'Produced by `{command}`'
+        + (' (quick mode: smaller sizes, fewer steps; not for decisions)' if quick else '')
+        + '.'
+    )
     L.append('')
-    L.append('Packings: ' + '; '.join(
-        f"N = {p['n']}: side {p['packing']['side']:.3g}, porosity {p['packing']['porosity']:.3f}, "
-        f"largest overlap {100 * p['packing']['max_overlap_over_r']:.1f} % of the smaller radius, "
-        f"{p['configs'][0]['n_cells']} cells"
-        for p in perm) + '.')
+    L.append(
+        'Packings: '
+        + '; '.join(
+            f"N = {p['n']}: side {p['packing']['side']:.3g}, porosity {p['packing']['porosity']:.3f}, "
+            f"largest overlap {100 * p['packing']['max_overlap_over_r']:.1f} % of the smaller radius, "
+            f"{p['configs'][0]['n_cells']} cells"
+            for p in perm
+        )
+        + '.'
+    )
     L.append('')
     for p in perm:
         L.append(f"### Permeameter, N = {p['n']} (medians of {p['rounds']} rounds)")
         L.append('')
-        L.append('| solver | first step: CPU ms (mesh + set-up + cold solve) | iterations | G_error | flux error | '
-                 'pressure error | force error | steady step: CPU ms | iterations | max G_error | max pressure error |')
+        L.append(
+            '| solver | first step: CPU ms (mesh + set-up + cold solve) | iterations | G_error | flux error | '
+            'pressure error | force error | steady step: CPU ms | iterations | max G_error | max pressure error |'
+        )
         L.append('|---|---|---|---|---|---|---|---|---|---|---|')
         for c in p['configs']:
             ef, es = c['err_first'], c['err_steady']
-            L.append(f"| {c['name']} | {c['first_median'] * 1e3:.1f} | {c['iters_first']} | {fmt(ef['g_error'])} | "
-                     f"{fmt(ef['q_error'])} | {fmt(ef['p_error'])} | {fmt(ef['f_error'])} | "
-                     f"{c['step_median'] * 1e3:.2f} | {c['iters_steady']:.0f} | {fmt(es['g_error'])} | "
-                     f"{fmt(es['p_error'])} |")
+            L.append(
+                f"| {c['name']} | {c['first_median'] * 1e3:.1f} | {c['iters_first']} | {fmt(ef['g_error'])} | "
+                f"{fmt(ef['q_error'])} | {fmt(ef['p_error'])} | {fmt(ef['f_error'])} | "
+                f"{c['step_median'] * 1e3:.2f} | {c['iters_steady']:.0f} | {fmt(es['g_error'])} | "
+                f"{fmt(es['p_error'])} |"
+            )
         L.append('')
         pts = [(c['step_median'], max(c['err_steady']['p_error'], 1e-12)) for c in p['configs']]
-        L.append('Pareto front (steady-step cost, max pressure error): ' + ' → '.join(
-            f"{p['configs'][i]['name']} ({pts[i][0] * 1e3:.2f} ms, {fmt(pts[i][1]) if pts[i][1] > 1e-12 else '0'})"
-            for i in pareto(pts)) + '.')
+        L.append(
+            'Pareto front (steady-step cost, max pressure error): '
+            + ' → '.join(
+                f"{p['configs'][i]['name']} ({pts[i][0] * 1e3:.2f} ms, {fmt(pts[i][1]) if pts[i][1] > 1e-12 else '0'})"
+                for i in pareto(pts)
+            )
+            + '.'
+        )
         L.append('')
     for scene in ('slow', 'fast'):
         for p in sorted([q for q in parts if q['scene'] == scene], key=lambda q: q['n']):
             title = 'slow consolidation' if scene == 'slow' else 'fast deformation'
-            L.append(f"### Oedometer, {title}, N = {p['n']}: {p['steps']} steps, settlement {100 * p['eps_f']:g} %, "
-                     f"tau = {p['tau']:g} steps (largest strain per step {p['max_strain_rate_per_step']:.2g})")
+            L.append(
+                f"### Oedometer, {title}, N = {p['n']}: {p['steps']} steps, settlement {100 * p['eps_f']:g} %, "
+                f"tau = {p['tau']:g} steps (largest strain per step {p['max_strain_rate_per_step']:.2g})"
+            )
             L.append('')
-            L.append('| option | remeshes | CPU ms/step (amortised) | of which remesh steps | mean iterations | '
-                     'e_base (RMS) | e_base (max) | e_mid | e_force | conservation |')
+            L.append(
+                '| option | remeshes | CPU ms/step (amortised) | of which remesh steps | mean iterations | '
+                'e_base (RMS) | e_base (max) | e_mid | e_force | conservation |'
+            )
             L.append('|---|---|---|---|---|---|---|---|---|---|')
             for c in p['configs']:
                 extra = f" (same mesh: {fmt(c['e_base_same_mesh'])})" if 'e_base_same_mesh' in c else ''
-                L.append(f"| {c['name']} | {c['remeshes']} | {c['cost'] * 1e3:.2f} | {c['remesh_cpu'] * 1e3:.2f} | "
-                         f"{c['iters_mean']:.0f} | {fmt(c['e_base'])}{extra} | {fmt(c['e_base_max'])} | "
-                         f"{fmt(c['e_mid'])} | {fmt(c['e_force'])} | {fmt(c['conservation'])} |")
+                L.append(
+                    f"| {c['name']} | {c['remeshes']} | {c['cost'] * 1e3:.2f} | {c['remesh_cpu'] * 1e3:.2f} | "
+                    f"{c['iters_mean']:.0f} | {fmt(c['e_base'])}{extra} | {fmt(c['e_base_max'])} | "
+                    f"{fmt(c['e_mid'])} | {fmt(c['e_force'])} | {fmt(c['conservation'])} |"
+                )
             L.append('')
             pts = [(c['cost'], max(c['e_base'], 1e-12)) for c in p['configs']]
             front = pareto(pts)
-            L.append('Pareto front (cost, e_base): ' + ' → '.join(
-                f"{p['configs'][i]['name']} ({pts[i][0] * 1e3:.2f} ms, {fmt(pts[i][1]) if pts[i][1] > 1e-12 else '0'})"
-                for i in front) + '.')
+            L.append(
+                'Pareto front (cost, e_base): '
+                + ' → '.join(
+                    f"{p['configs'][i]['name']} ({pts[i][0] * 1e3:.2f} ms, "
+                    f"{fmt(pts[i][1]) if pts[i][1] > 1e-12 else '0'})"
+                    for i in front
+                )
+                + '.'
+            )
             L.append('')
     L.append('### Pareto fronts, all scenes')
     L.append('')
-    L.append('Permeameter: steady-step cost against max pressure error / p_in; oedometers: amortised cost per step '
-             'against e_base. Errors below 1e-12 count as 1e-12 (the reference is 0).')
+    L.append(
+        'Permeameter: steady-step cost against max pressure error / p_in; oedometers: amortised cost per step '
+        'against e_base. Errors below 1e-12 count as 1e-12 (the reference is 0).'
+    )
     L.append('')
     L.append('| scene | N | option | CPU ms/step | error |')
     L.append('|---|---|---|---|---|')
@@ -440,23 +558,37 @@ def report(parts, command, quick):
             else:
                 pts = [(c['cost'], max(c['e_base'], 1e-12)) for c in p['configs']]
             for i in pareto(pts):
-                L.append(f"| {titles[scene]} | {p['n']} | {p['configs'][i]['name']} | {pts[i][0] * 1e3:.2f} | "
-                         f"{fmt(pts[i][1]) if pts[i][1] > 1e-12 else '0'} |")
+                L.append(
+                    f"| {titles[scene]} | {p['n']} | {p['configs'][i]['name']} | {pts[i][0] * 1e3:.2f} | "
+                    f"{fmt(pts[i][1]) if pts[i][1] > 1e-12 else '0'} |"
+                )
     L.append('')
     return '\n'.join(L)
 
 
 def figure(parts, path):
     import matplotlib
+
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    panels = [('perm', 'first', 'permeameter, first solve (mesh + set-up + cold solve)',
-               'G_error = |Qin + Qout| / |Qin|'),
-              ('perm', 'steady', 'permeameter, steady step (varying inlet pressure)', 'max pressure error / p_in'),
-              ('slow', None, 'oedometer, slow consolidation', 'e_base (RMS / peak base pressure)'),
-              ('fast', None, 'oedometer, fast deformation', 'e_base (RMS / peak base pressure)')]
-    colours = {'CHOLMOD': 'k', 'reference': 'k', 'GS': 'tab:blue', 'PCG': 'tab:orange', 'interval': 'tab:green',
-               'defTolerance': 'tab:red', 'background': 'tab:purple', 'mixed': 'tab:brown', 'AMG-PCG': 'tab:cyan'}
+
+    panels = [
+        ('perm', 'first', 'permeameter, first solve (mesh + set-up + cold solve)', 'G_error = |Qin + Qout| / |Qin|'),
+        ('perm', 'steady', 'permeameter, steady step (varying inlet pressure)', 'max pressure error / p_in'),
+        ('slow', None, 'oedometer, slow consolidation', 'e_base (RMS / peak base pressure)'),
+        ('fast', None, 'oedometer, fast deformation', 'e_base (RMS / peak base pressure)'),
+    ]
+    colours = {
+        'CHOLMOD': 'k',
+        'reference': 'k',
+        'GS': 'tab:blue',
+        'PCG': 'tab:orange',
+        'interval': 'tab:green',
+        'defTolerance': 'tab:red',
+        'background': 'tab:purple',
+        'mixed': 'tab:brown',
+        'AMG-PCG': 'tab:cyan',
+    }
     sizes = sorted({p['n'] for p in parts})
     markers = ['o', 's', '^', 'D']
     fig, axes = plt.subplots(2, 2, figsize=(11, 8))
@@ -467,8 +599,10 @@ def figure(parts, path):
                 for c in p['configs']:
                     if scene == 'perm':
                         fam = c.get('family', c['name'].split()[0])
-                        pt = ((c['first_median'] if kind == 'first' else c['step_median']) * 1e3,
-                              c['err_first']['g_error'] if kind == 'first' else c['err_steady']['p_error'])
+                        pt = (
+                            (c['first_median'] if kind == 'first' else c['step_median']) * 1e3,
+                            c['err_first']['g_error'] if kind == 'first' else c['err_steady']['p_error'],
+                        )
                     else:
                         fam, pt = c['family'], (c['cost'] * 1e3, c['e_base'])
                     data.append((si, n, fam, pt))
@@ -478,15 +612,28 @@ def figure(parts, path):
             pts = [(d[3][0], max(d[3][1], floor)) for d in data if d[0] == si]
             for d in (d for d in data if d[0] == si):
                 col = colours.get(d[2], 'grey')
-                ax.loglog(d[3][0], max(d[3][1], floor), markers[si], color=col, ms=5, alpha=0.85,
-                          mfc='none' if si else col)
+                ax.loglog(
+                    d[3][0], max(d[3][1], floor), markers[si], color=col, ms=5, alpha=0.85, mfc='none' if si else col
+                )
             if pts:
                 front = pareto(pts)
-                ax.loglog([pts[i][0] for i in front], [pts[i][1] for i in front], '-', color='grey', lw=0.8,
-                          label=f'Pareto front, N = {n} ({"filled" if si == 0 else "open"} {markers[si]})')
+                ax.loglog(
+                    [pts[i][0] for i in front],
+                    [pts[i][1] for i in front],
+                    '-',
+                    color='grey',
+                    lw=0.8,
+                    label=f'Pareto front, N = {n} ({"filled" if si == 0 else "open"} {markers[si]})',
+                )
         ax.axhline(floor, color='grey', ls=':', lw=0.6)
-        ax.text(0.01, 0.01, 'on the dotted line: error exactly 0 (the reference)', transform=ax.transAxes,
-                fontsize=6, color='grey')
+        ax.text(
+            0.01,
+            0.01,
+            'on the dotted line: error exactly 0 (the reference)',
+            transform=ax.transAxes,
+            fontsize=6,
+            color='grey',
+        )
         ax.set_title(title, fontsize=9)
         ax.set_xlabel('CPU ms' + ('' if kind == 'first' else ' per step'), fontsize=8)
         ax.set_ylabel(ylabel, fontsize=8)
@@ -528,6 +675,7 @@ def main():
     part = option(sys.argv[1:], 'part', '')
     if part:
         import pfv
+
         pfv.set_num_threads(1)
         scene, n = part.split(':')
         n = int(n)
@@ -543,12 +691,17 @@ def main():
             packing(n, work)
         jobs = option(sys.argv[1:], 'jobs', 1)
         env = dict(os.environ, OMP_NUM_THREADS='1', OPENBLAS_NUM_THREADS='1')
-        running, pending = [], list(todo)   # largest first: the biggest task starts at once
+        running, pending = [], list(todo)  # largest first: the biggest task starts at once
         while pending or running:
             while pending and len(running) < jobs:
                 s, n = pending.pop(0)
-                args = [sys.executable, os.path.abspath(__file__), f'--part={s}:{n}', f'--work={work}',
-                        f'--rounds={rounds}'] + (['--quick'] if quick else [])
+                args = [
+                    sys.executable,
+                    os.path.abspath(__file__),
+                    f'--part={s}:{n}',
+                    f'--work={work}',
+                    f'--rounds={rounds}',
+                ] + (['--quick'] if quick else [])
                 log('start', s, n)
                 running.append((subprocess.Popen(args, env=env), s, n))
             time.sleep(1)
@@ -563,14 +716,18 @@ def main():
         with open(os.path.join(work, f'part_{s}_{n}{"_quick" if quick else ""}.json')) as f:
             parts.append(json.load(f))
     command = 'PYTHONPATH=build/python /usr/bin/python3.11 bench/tradeoffs.py ' + ' '.join(
-        a for a in sys.argv[1:] if not a.startswith('--report-only'))
+        a for a in sys.argv[1:] if not a.startswith('--report-only')
+    )
     text = report(parts, command.strip(), quick)
     print(text)
     out = option(sys.argv[1:], 'out', '')
     if out:
         write_report(out, text)
-        fig = option(sys.argv[1:], 'figure', os.path.join(os.path.dirname(out) or '.', 'figures',
-                                                          'tradeoffs_quick.png' if quick else 'tradeoffs.png'))
+        fig = option(
+            sys.argv[1:],
+            'figure',
+            os.path.join(os.path.dirname(out) or '.', 'figures', 'tradeoffs_quick.png' if quick else 'tradeoffs.png'),
+        )
         figure(parts, fig)
         log('wrote', out, 'and', fig)
     return 0

@@ -70,9 +70,13 @@ for mode in args.modes.split(","):
         rt, st = e.remesh_times(), e.step_times()
         shear_geometry.append(rt.get("shear_geometry", 0.0))
         shear_forces.append(st.get("shear_forces", 0.0))
-    results[mode] = dict(remesh_ms=1e3 * statistics.median(remesh), step_ms=1e3 * statistics.median(steady),
-                         shear_geometry_ms=1e3 * statistics.median(shear_geometry),
-                         shear_forces_ms=1e3 * statistics.median(shear_forces), cells=e.n_cells())
+    results[mode] = dict(
+        remesh_ms=1e3 * statistics.median(remesh),
+        step_ms=1e3 * statistics.median(steady),
+        shear_geometry_ms=1e3 * statistics.median(shear_geometry),
+        shear_forces_ms=1e3 * statistics.median(shear_forces),
+        cells=e.n_cells(),
+    )
     if mode == "on":
         results[mode]["pairs"] = int(len(e.shear_pairs()["a"]))
 print(json.dumps(dict(label=args.label, spheres=len(centres0), rounds=args.rounds, steps=args.steps, results=results)))

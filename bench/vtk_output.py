@@ -107,8 +107,10 @@ def profile(flow: PfvFlowEngine, folder: str, with_boundaries: bool) -> dict[str
 def run_size(n: int, opts: dict) -> dict:
     t0 = time.perf_counter()
     yade_flow, pfv_flow = build_scene(n)
-    log(f"n={n}: scene and first step in {time.perf_counter() - t0:.1f} s, {pfv_flow.nCells()} PFV cells, "
-        f"{yade_flow.nCells()} YADE cells")
+    log(
+        f"n={n}: scene and first step in {time.perf_counter() - t0:.1f} s, {pfv_flow.nCells()} PFV cells, "
+        f"{yade_flow.nCells()} YADE cells"
+    )
     root = os.path.join(opts["dir"], f"n{n}")
     os.makedirs(root, exist_ok=True)  # YADE makes the last level of a folder only
     cases = {
@@ -123,7 +125,7 @@ def run_size(n: int, opts: dict) -> dict:
     sizes = {}
     parts = []
     for r in range(opts["rounds"]):
-        order = names[r % len(names):] + names[:r % len(names)]
+        order = names[r % len(names) :] + names[: r % len(names)]
         for name in order:
             folder = os.path.join(root, f"{name}-{r}")
             start = time.perf_counter()
@@ -135,31 +137,54 @@ def run_size(n: int, opts: dict) -> dict:
             parts.append(profile(pfv_flow, os.path.join(root, "profile"), False))
             shutil.rmtree(os.path.join(root, "profile"))
         log(f"n={n} round {r}: " + ", ".join(f"{k} {times[k][-1]:.3f} s" for k in names))
-    result = dict(n=n, cells=pfv_flow.nCells(), yade_cells=yade_flow.nCells(),
-                  median={k: statistics.median(v) for k, v in times.items()}, bytes=sizes, times=times)
+    result = dict(
+        n=n,
+        cells=pfv_flow.nCells(),
+        yade_cells=yade_flow.nCells(),
+        median={k: statistics.median(v) for k, v in times.items()},
+        bytes=sizes,
+        times=times,
+    )
     if parts:
         result["parts"] = {k: statistics.median(p[k] for p in parts) for k in parts[0]}
     return result
 
 
 def report(results: list[dict], opts: dict) -> str:
-    command = (f"nice -n 10 yade-double -j1 -n -x bench/vtk_output.py --sizes={','.join(map(str, opts['sizes']))} "
-               f"--rounds={opts['rounds']}{' --profile' if opts['profile'] else ''}")
-    lines = [f"`{command}`, median of {opts['rounds']} rounds (wall clock of the call, files in the page cache):", "",
-             "| N | cells (PFV / YADE) | call | YADE [s] | PFV [s] | PFV / YADE | written (YADE / PFV) |",
-             "|---|---|---|---|---|---|---|"]
+    command = (
+        f"nice -n 10 yade-double -j1 -n -x bench/vtk_output.py --sizes={','.join(map(str, opts['sizes']))} "
+        f"--rounds={opts['rounds']}{' --profile' if opts['profile'] else ''}"
+    )
+    lines = [
+        f"`{command}`, median of {opts['rounds']} rounds (wall clock of the call, files in the page cache):",
+        "",
+        "| N | cells (PFV / YADE) | call | YADE [s] | PFV [s] | PFV / YADE | written (YADE / PFV) |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for res in results:
         m, b = res["median"], res["bytes"]
-        rows = (("saveVtk(dir)", "yade", "pfv"), ("saveVtk(dir, compress=True)", "yade", "pfv-zlib"),
-                ("saveVtk(dir, True)", "yade-boundaries", "pfv-boundaries"))
+        rows = (
+            ("saveVtk(dir)", "yade", "pfv"),
+            ("saveVtk(dir, compress=True)", "yade", "pfv-zlib"),
+            ("saveVtk(dir, True)", "yade-boundaries", "pfv-boundaries"),
+        )
         for label, y, p in rows:
             yade_text = f"{m[y]:.3f}" if label != "saveVtk(dir, compress=True)" else f"({m[y]:.3f})"
-            lines.append(f"| {res['n']:,} | {res['cells']:,} / {res['yade_cells']:,} | `{label}` | {yade_text} | "
-                         f"{m[p]:.3f} | {m[p] / m[y]:.2f} | {b[y] / 1e6:.1f} MB / {b[p] / 1e6:.1f} MB |")
+            lines.append(
+                f"| {res['n']:,} | {res['cells']:,} / {res['yade_cells']:,} | `{label}` | {yade_text} | "
+                f"{m[p]:.3f} | {m[p] / m[y]:.2f} | {b[y] / 1e6:.1f} MB / {b[p] / 1e6:.1f} MB |"
+            )
     if any("parts" in r for r in results):
-        lines += ["", "PFV's `saveVtk(dir)` in parts (median): " + "; ".join(
-            f"N = {r['n']:,}: read {r['parts']['read']:.3f} s, build {r['parts']['build']:.3f} s, "
-            f"write {r['parts']['write']:.3f} s" for r in results if "parts" in r)]
+        lines += [
+            "",
+            "PFV's `saveVtk(dir)` in parts (median): "
+            + "; ".join(
+                f"N = {r['n']:,}: read {r['parts']['read']:.3f} s, build {r['parts']['build']:.3f} s, "
+                f"write {r['parts']['write']:.3f} s"
+                for r in results
+                if "parts" in r
+            ),
+        ]
     return "\n".join(lines)
 
 

@@ -67,8 +67,13 @@ def main() -> None:
     for b in spheres:
         b.state.blockedDOFs = "xyzXYZ"
     O.bodies.append(spheres)
-    flow = FlowEngine(wallIds=list(range(6)), boundaryUseMaxMin=[False] * 6, useSolver=3,
-                      bndCondIsPressure=[False, False, False, True, False, False], meshUpdateInterval=10 ** 9)
+    flow = FlowEngine(
+        wallIds=list(range(6)),
+        boundaryUseMaxMin=[False] * 6,
+        useSolver=3,
+        bndCondIsPressure=[False, False, False, True, False, False],
+        meshUpdateInterval=10**9,
+    )
     O.engines = [ForceResetter(), flow, NewtonIntegrator(damping=0)]
     O.dt = 1e-4
     load = Timed(waves.StandingWave(amplitude=150.0, period=1.0, length=float(hi[0] - lo[0]), origin=float(lo[0])))
@@ -81,7 +86,7 @@ def main() -> None:
     stages = {True: {k: [] for k in STAGES}, False: {k: [] for k in STAGES}}
     load_seconds, field_share = [], []
     for r in range(opts["rounds"]):
-        for on in ((True, False) if r % 2 == 0 else (False, True)):
+        for on in (True, False) if r % 2 == 0 else (False, True):
             if on:
                 flow.set_boundary_pressure(flow.ymax, load)
             else:
@@ -109,18 +114,28 @@ def main() -> None:
     without, with_load = statistics.median(per_step[False]), statistics.median(per_step[True])
     core_without, core_with = statistics.median(engine[False]), statistics.median(engine[True])
     call = statistics.median(load_seconds)
-    print(f"wave_cost: {opts['spheres']} spheres, {flow.nCells()} cells, {n_top} cells on ymax; "
-          f"{opts['rounds']} rounds of {opts['steps']} steps with and without the load")
-    print(f"wave_cost: O.run per step      without {without * 1e3:.3f} ms, with {with_load * 1e3:.3f} ms, "
-          f"ratio - 1 = {with_load / without - 1:+.2%}")
-    print(f"wave_cost: C++ step per step   without {core_without * 1e3:.3f} ms, with {core_with * 1e3:.3f} ms, "
-          f"ratio - 1 = {core_with / core_without - 1:+.2%}")
+    print(
+        f"wave_cost: {opts['spheres']} spheres, {flow.nCells()} cells, {n_top} cells on ymax; "
+        f"{opts['rounds']} rounds of {opts['steps']} steps with and without the load"
+    )
+    print(
+        f"wave_cost: O.run per step      without {without * 1e3:.3f} ms, with {with_load * 1e3:.3f} ms, "
+        f"ratio - 1 = {with_load / without - 1:+.2%}"
+    )
+    print(
+        f"wave_cost: C++ step per step   without {core_without * 1e3:.3f} ms, with {core_with * 1e3:.3f} ms, "
+        f"ratio - 1 = {core_with / core_without - 1:+.2%}"
+    )
     print(f"wave_cost: the load's Python call {call * 1e6:.1f} us = {call / core_without:.2%} of the C++ step")
     for on in (False, True):
-        print(f"wave_cost: stages {'with   ' if on else 'without'} " + ", ".join(
-            f"{k} {statistics.median(stages[on][k]) * 1e3:.3f} ms" for k in STAGES))
-    print(f"wave_cost: the core's pressure_field stage (GIL, arrays, the call, checks) = "
-          f"{statistics.median(field_share):.2%} of the C++ step")
+        print(
+            f"wave_cost: stages {'with   ' if on else 'without'} "
+            + ", ".join(f"{k} {statistics.median(stages[on][k]) * 1e3:.3f} ms" for k in STAGES)
+        )
+    print(
+        f"wave_cost: the core's pressure_field stage (GIL, arrays, the call, checks) = "
+        f"{statistics.median(field_share):.2%} of the C++ step"
+    )
 
 
 main()

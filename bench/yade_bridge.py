@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import yade
 from yade import O, pack, utils
-from yade.wrapper import (ForceResetter, NewtonIntegrator, PyRunner, Sphere)
+from yade.wrapper import ForceResetter, NewtonIntegrator, PyRunner, Sphere
 from yade.minieigenHP import Vector3
 
 from pfv_testing.timing import per_call_ms
@@ -24,7 +24,7 @@ def scene():
     O.reset()
     O.bodies.append(utils.aabbWalls([(0, 0, 0), (1, 1, 1)], thickness=0))
     sp = pack.SpherePack()
-    sp.makeCloud((0, 0, 0), (1, 1, 1), rMean=0.02 * (10000.0 / N) ** (1 / 3.), rRelFuzz=0.3, num=N, seed=1)
+    sp.makeCloud((0, 0, 0), (1, 1, 1), rMean=0.02 * (10000.0 / N) ** (1 / 3.0), rRelFuzz=0.3, num=N, seed=1)
     sp.toSimulation()
 
 
@@ -51,10 +51,14 @@ def bench_read():
         ('[b.state.pos for b in O.bodies] (Vector3 list)', lambda: [b.state.pos for b in O.bodies]),
         ('np.array([b.state.pos for b in O.bodies])', lambda: np.array([b.state.pos for b in O.bodies])),
         ('np.array([tuple(b.state.pos) ...])', lambda: np.array([tuple(b.state.pos) for b in O.bodies])),
-        ('radii+ids of spheres (isinstance Sphere)',
-         lambda: [(b.id, b.shape.radius) for b in O.bodies if isinstance(b.shape, Sphere)]),
-        ('velocities: loop v=b.state.vel; (v[0],v[1],v[2])',
-         lambda: np.array([(v[0], v[1], v[2]) for v in (b.state.vel for b in O.bodies)])),
+        (
+            'radii+ids of spheres (isinstance Sphere)',
+            lambda: [(b.id, b.shape.radius) for b in O.bodies if isinstance(b.shape, Sphere)],
+        ),
+        (
+            'velocities: loop v=b.state.vel; (v[0],v[1],v[2])',
+            lambda: np.array([(v[0], v[1], v[2]) for v in (b.state.vel for b in O.bodies)]),
+        ),
     ]
     print('\nread, %d bodies (%d spheres + 6 walls):' % (n, N))
     for name, f in rows:
@@ -70,8 +74,10 @@ def bench_write():
     addF = O.forces.addF
     rows = [
         ('addF(i, tuple), tuples made beforehand', lambda: [addF(i, f) for i, f in zip(ids, tuples)]),
-        ('O.forces.addF(i, tuple) (attribute lookup each call)',
-         lambda: [O.forces.addF(i, f) for i, f in zip(ids, tuples)]),
+        (
+            'O.forces.addF(i, tuple) (attribute lookup each call)',
+            lambda: [O.forces.addF(i, f) for i, f in zip(ids, tuples)],
+        ),
         ('addF(i, Vector3), Vector3 made beforehand', lambda: [addF(i, f) for i, f in zip(ids, vecs)]),
         ('addF(i, Vector3(x,y,z)) made each call', lambda: [addF(i, Vector3(*f)) for i, f in zip(ids, tuples)]),
         ('from numpy: map(addF, ids, map(tuple, F.tolist()))', lambda: list(map(addF, ids, map(tuple, F.tolist())))),
@@ -91,16 +97,22 @@ def check_same_step():
     m = O.bodies[0].state.mass
     O.dt = 1e-3
     import __main__
+
     __main__._bench_add = lambda: O.forces.addF(0, (m, 0, 0)) if O.iter == 0 else None
-    O.engines = [ForceResetter(), PyRunner(command='_bench_add()', iterPeriod=1, initRun=True),
-                 NewtonIntegrator(damping=0, gravity=(0, 0, 0))]
+    O.engines = [
+        ForceResetter(),
+        PyRunner(command='_bench_add()', iterPeriod=1, initRun=True),
+        NewtonIntegrator(damping=0, gravity=(0, 0, 0)),
+    ]
     O.step()
     v1 = O.bodies[0].state.vel[0] / O.dt
     O.step()
     v2 = O.bodies[0].state.vel[0] / O.dt
     ok = abs(v1 - 1) < 1e-12 and abs(v2 - 1) < 1e-12
-    print('\naddF in a PyRunner before NewtonIntegrator: v/dt after step 1 = %g (expect 1: same step), '
-          'after step 2 = %g (expect 1: reset by ForceResetter) -> %s' % (v1, v2, 'ok' if ok else 'UNEXPECTED'))
+    print(
+        '\naddF in a PyRunner before NewtonIntegrator: v/dt after step 1 = %g (expect 1: same step), '
+        'after step 2 = %g (expect 1: reset by ForceResetter) -> %s' % (v1, v2, 'ok' if ok else 'UNEXPECTED')
+    )
     return ok
 
 

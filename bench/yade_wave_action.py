@@ -21,8 +21,16 @@ def probes(flow, what):
 
 
 scenes.build_permeameter(num=1000, frozen=True)
-flow = FlowEngine(label="flow", wallIds=list(range(6)), bndCondIsPressure=[0, 0, 0, 1, 0, 0], bndCondValue=[0] * 6,
-                  boundaryUseMaxMin=[0] * 6, waveAction=True, sineAverage=10, sineMagnitude=5)
+flow = FlowEngine(
+    label="flow",
+    wallIds=list(range(6)),
+    bndCondIsPressure=[0, 0, 0, 1, 0, 0],
+    bndCondValue=[0] * 6,
+    boundaryUseMaxMin=[0] * 6,
+    waveAction=True,
+    sineAverage=10,
+    sineMagnitude=5,
+)
 scenes.insert_flow(flow)
 O.run(1, True)
 probes(flow, "first step (mag 5)")
@@ -43,5 +51,7 @@ off_level = max(abs(p - levels[k]) for (_, p), k in zip(top, level))
 floor = sum(k == min(max(math.floor(30 * x), 0), 29) for (x, _), k in zip(top, level))
 lag = max(abs(k - 30 * x) for (x, _), k in zip(top, level) if 0 < x < 1)
 print(f"yade_wave_action: {len(top)} imposed top cells; max |p - cos at own x| = {own:.4f}")
-print(f"yade_wave_action: every cell at one of the levels 10 + 20 cos(pi k / 30), k = 0..29, to {off_level:.1e}; "
-      f"k = floor(30 x) for {floor} of {len(top)} (x: getCellCenter), |k - 30 x| <= {lag:.3f}")
+print(
+    f"yade_wave_action: every cell at one of the levels 10 + 20 cos(pi k / 30), k = 0..29, to {off_level:.1e}; "
+    f"k = floor(30 x) for {floor} of {len(top)} (x: getCellCenter), |k - 30 x| <= {lag:.3f}"
+)

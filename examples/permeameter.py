@@ -8,9 +8,18 @@ permeability K from Darcy's law Q = K A dP / (mu L), the mean pressure across th
 the pressure drop doubled (Darcy: Q doubles, K stays). For a deforming, coupled sample see examples/oedometer.py.
 """
 from yade import O, pack, utils
-from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, Ig2_Box_Sphere_ScGeom,
-                          Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                          Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator)
+from yade.wrapper import (
+    Bo1_Box_Aabb,
+    Bo1_Sphere_Aabb,
+    ForceResetter,
+    Ig2_Box_Sphere_ScGeom,
+    Ig2_Sphere_Sphere_ScGeom,
+    InsertionSortCollider,
+    InteractionLoop,
+    Ip2_FrictMat_FrictMat_FrictPhys,
+    Law2_ScGeom_FrictPhys_CundallStrack,
+    NewtonIntegrator,
+)
 from pfv import FlowEngine
 
 L = 0.01  # side of the cubic box [m]
@@ -40,8 +49,11 @@ flow.bndCondIsPressure = [False, False, True, True, False, False]  # pressure on
 O.engines = [
     ForceResetter(),
     InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-    InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                    [Law2_ScGeom_FrictPhys_CundallStrack()]),
+    InteractionLoop(
+        [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+        [Ip2_FrictMat_FrictMat_FrictPhys()],
+        [Law2_ScGeom_FrictPhys_CundallStrack()],
+    ),
     flow,
     NewtonIntegrator(damping=0.2),
 ]
@@ -52,8 +64,12 @@ for dp in (DP, 2 * DP):
     O.run(3, True)  # the spheres are fixed: every step gives the same steady flow
     q_in, q_out = flow.getBoundaryFlux(YMIN), flow.getBoundaryFlux(YMAX)  # YADE's sign: > 0 leaves the sample
     K = abs(q_in) * MU * L / (L * L * dp)  # intrinsic permeability [m^2]
-    print('dP = %g Pa: Q_in = %.15e m3/s, Q_out = %.15e m3/s, Q_in + Q_out = %.3e m3/s, K = %.6e m2'
-          % (dp, q_in, q_out, q_in + q_out, K))
+    print(
+        'dP = %g Pa: Q_in = %.15e m3/s, Q_out = %.15e m3/s, Q_in + Q_out = %.3e m3/s, K = %.6e m2'
+        % (dp, q_in, q_out, q_in + q_out, K)
+    )
     for y in (0.25, 0.5, 0.75):
-        print('  mean pressure at y/L = %.2f: %.6f Pa (linear: %.6f Pa)'
-              % (y, flow.averageSlicePressure(y * L, 1), dp * (1 - y)))
+        print(
+            '  mean pressure at y/L = %.2f: %.6f Pa (linear: %.6f Pa)'
+            % (y, flow.averageSlicePressure(y * L, 1), dp * (1 - y))
+        )

@@ -20,9 +20,19 @@ import os
 import sys
 
 from yade import O, pack, utils
-from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,
-                          Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                          Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator)
+from yade.wrapper import (
+    Bo1_Box_Aabb,
+    Bo1_Sphere_Aabb,
+    ForceResetter,
+    FrictMat,
+    Ig2_Box_Sphere_ScGeom,
+    Ig2_Sphere_Sphere_ScGeom,
+    InsertionSortCollider,
+    InteractionLoop,
+    Ip2_FrictMat_FrictMat_FrictPhys,
+    Law2_ScGeom_FrictPhys_CundallStrack,
+    NewtonIntegrator,
+)
 
 GRAINS = dict(d50=0.06, size_ratio=1.22, young=15e6, kt_kn=0.5, density=2600.0)
 SIMULATION_FRICTION = 30.0  # deg, phi_c2
@@ -52,17 +62,28 @@ def _engines():
     return [
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-        InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                        [Law2_ScGeom_FrictPhys_CundallStrack()]),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys()],
+            [Law2_ScGeom_FrictPhys_CundallStrack()],
+        ),
         NewtonIntegrator(damping=0.3, gravity=(0, -GRAVITY, 0)),
     ]
 
 
 def _materials(friction):
-    O.materials.append(FrictMat(young=GRAINS["young"], poisson=GRAINS["kt_kn"], frictionAngle=math.radians(friction),
-                                density=GRAINS["density"], label="grains"))
-    O.materials.append(FrictMat(young=GRAINS["young"], poisson=GRAINS["kt_kn"], frictionAngle=0, density=0,
-                                label="walls"))
+    O.materials.append(
+        FrictMat(
+            young=GRAINS["young"],
+            poisson=GRAINS["kt_kn"],
+            frictionAngle=math.radians(friction),
+            density=GRAINS["density"],
+            label="grains",
+        )
+    )
+    O.materials.append(
+        FrictMat(young=GRAINS["young"], poisson=GRAINS["kt_kn"], frictionAngle=0, density=0, label="walls")
+    )
 
 
 def interior_porosity(L, h_bed, W):
@@ -148,9 +169,12 @@ def main(argv):
         s = prepare(num, friction)
         thesis = THESIS_POROSITY.get(friction)
         rows.append(dict(friction=friction, num=num, porosity=s["porosity"], thesis=thesis, box=s["box"]))
-        print(f"seabed sample: {num} grains, phi_c1 = {friction:g} deg: interior porosity {s['porosity']:.3f}"
-              + (f" (thesis {thesis})" if thesis else "") + f", bed {s['box'][0]:.3f} x {s['box'][1]:.3f} x "
-              f"{s['box'][2]:.3f} m")
+        print(
+            f"seabed sample: {num} grains, phi_c1 = {friction:g} deg: interior porosity {s['porosity']:.3f}"
+            + (f" (thesis {thesis})" if thesis else "")
+            + f", bed {s['box'][0]:.3f} x {s['box'][1]:.3f} x "
+            f"{s['box'][2]:.3f} m"
+        )
     if out:
         with open(out, "w") as f:
             json.dump(rows, f, indent=1)

@@ -28,8 +28,8 @@ from yade.wrapper import NewtonIntegrator, PyRunner  # noqa: E402
 from pfv import FlowEngine, diagnostics  # noqa: E402
 
 RHO_F = 1000.0
-VISCOSITY = 100.0      # Pa.s, thesis Tables 6.2/6.3 (0.1 kPa.s)
-LIQUEFIED = 0.8        # grad H / i_c (thesis 6.4)
+VISCOSITY = 100.0  # Pa.s, thesis Tables 6.2/6.3 (0.1 kPa.s)
+LIQUEFIED = 0.8  # grad H / i_c (thesis 6.4)
 
 
 def options(argv, defaults):
@@ -51,8 +51,15 @@ def build(sample, settings=None):
     was chosen from."""
     seabed_sample.load_into_scene(sample)
     L, h, W = sample["box"]
-    flow = FlowEngine(label="flow", viscosity=VISCOSITY, fluid_density=RHO_F, meshUpdateInterval=200,
-                      bndCondIsPressure=[0, 0, 0, 1, 0, 0], bndCondValue=[0] * 6, boundaryUseMaxMin=[0] * 6)
+    flow = FlowEngine(
+        label="flow",
+        viscosity=VISCOSITY,
+        fluid_density=RHO_F,
+        meshUpdateInterval=200,
+        bndCondIsPressure=[0, 0, 0, 1, 0, 0],
+        bndCondValue=[0] * 6,
+        boundaryUseMaxMin=[0] * 6,
+    )
     for name, value in (settings or {}).items():
         setattr(flow, name, value)
     engines = list(O.engines)
@@ -69,8 +76,12 @@ def build(sample, settings=None):
     O.dt = first
     O.run(1, True)
     O.dt = 0.6 * flow.critical_time_step
-    time_steps = dict(first_step=first, viscous=flow.viscous_time_step,
-                      collective_viscous=flow.collective_viscous_time_step, p_wave=utils.PWaveTimeStep())
+    time_steps = dict(
+        first_step=first,
+        viscous=flow.viscous_time_step,
+        collective_viscous=flow.collective_viscous_time_step,
+        p_wave=utils.PWaveTimeStep(),
+    )
     return flow, (L, h, W), time_steps
 
 
@@ -80,9 +91,20 @@ def run(load_name, load, sample, duration, out, period, settings=None):
     flow.set_boundary_pressure(flow.ymax, load)
     n0 = sample["porosity"]
     grid = diagnostics.SensorGrid.in_box((0, 0, 0), (L, h, W), verticals=5, levels=6)
-    monitor = diagnostics.Monitor(flow, grid, n0, seabed_sample.GRAINS["density"], RHO_F, L * W, bottom=0.0,
-                                  amplitude=load.amplitude_at, t_end=duration, report_every=25)
+    monitor = diagnostics.Monitor(
+        flow,
+        grid,
+        n0,
+        seabed_sample.GRAINS["density"],
+        RHO_F,
+        L * W,
+        bottom=0.0,
+        amplitude=load.amplitude_at,
+        t_end=duration,
+        report_every=25,
+    )
     import builtins
+
     builtins.seabed_monitor = monitor
     record = max(1, int(round(duration / 400 / O.dt)))
     O.engines = O.engines + [PyRunner(command="seabed_monitor()", iterPeriod=record)]
@@ -100,12 +122,17 @@ def run(load_name, load, sample, duration, out, period, settings=None):
 
     ids, pos, rad, _, _ = diagnostics.sphere_arrays(O.bodies)
     top = diagnostics.top_height(pos, rad, 0.99)
-    heights, sigma = diagnostics.effective_stress_profile(utils.bodyStressTensors(), ids, pos, rad, 0.0, top, 6,
-                                                          L * W, x_band=(0.4 * L, 0.6 * L))
+    heights, sigma = diagnostics.effective_stress_profile(
+        utils.bodyStressTensors(), ids, pos, rad, 0.0, top, 6, L * W, x_band=(0.4 * L, 0.6 * L)
+    )
     depth, dx = diagnostics.horizontal_displacements(pos, start, 0.5 * L, 0.1 * L)
-    profiles = dict(heights=heights.tolist(), sigma_eff_yy=sigma.tolist(),
-                    pore_pressure=diagnostics.pressure_profile(flow, 0.5 * L, 0.5 * W, heights).tolist(),
-                    axis_initial_height=depth.tolist(), axis_dx=dx.tolist())
+    profiles = dict(
+        heights=heights.tolist(),
+        sigma_eff_yy=sigma.tolist(),
+        pore_pressure=diagnostics.pressure_profile(flow, 0.5 * L, 0.5 * W, heights).tolist(),
+        axis_initial_height=depth.tolist(),
+        axis_dx=dx.tolist(),
+    )
     with open(os.path.join(out, "profiles.json"), "w") as f:
         json.dump(profiles, f, indent=1)
 
@@ -113,18 +140,32 @@ def run(load_name, load, sample, duration, out, period, settings=None):
     ratio = np.mean([plot.data[k] for k in plot.data if k.startswith("r_")], axis=0)
     window = max(1, int(round(period / (t[1] - t[0])))) if len(t) > 1 else 1
     smooth = np.convolve(ratio, np.ones(window) / window, mode="valid")
-    after = t[window - 1:] >= period
+    after = t[window - 1 :] >= period
     peak = float(np.max(smooth[after])) if np.any(after) else float("nan")
-    summary = dict(load=load_name, profile=repr(load), grains=sample["num"], friction_prep=sample["friction"],
-                   settings=settings or {}, porosity0=n0, i_c=monitor.i_c, duration=duration, dt=O.dt, steps=O.iter,
-                   time_steps=time_steps,
-                   wall_seconds=wall,
-                   peak_mean_ratio=peak, liquefied=bool(peak > LIQUEFIED),
-                   final_porosity=plot.data["porosity"][-1], settlement=plot.data["top"][0] - plot.data["top"][-1],
-                   max_axis_dx=float(np.max(np.abs(dx))) if len(dx) else 0.0)
+    summary = dict(
+        load=load_name,
+        profile=repr(load),
+        grains=sample["num"],
+        friction_prep=sample["friction"],
+        settings=settings or {},
+        porosity0=n0,
+        i_c=monitor.i_c,
+        duration=duration,
+        dt=O.dt,
+        steps=O.iter,
+        time_steps=time_steps,
+        wall_seconds=wall,
+        peak_mean_ratio=peak,
+        liquefied=bool(peak > LIQUEFIED),
+        final_porosity=plot.data["porosity"][-1],
+        settlement=plot.data["top"][0] - plot.data["top"][-1],
+        max_axis_dx=float(np.max(np.abs(dx))) if len(dx) else 0.0,
+    )
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=1)
     state = "liquefied" if summary["liquefied"] else "stable"
-    print(f"{load_name}: peak period-mean grad H / i_c {peak:.3f} -> {state}; "
-          f"n {n0:.3f} -> {summary['final_porosity']:.3f}; {O.iter} steps in {wall:.0f} s; outputs in {out}")
+    print(
+        f"{load_name}: peak period-mean grad H / i_c {peak:.3f} -> {state}; "
+        f"n {n0:.3f} -> {summary['final_porosity']:.3f}; {O.iter} steps in {wall:.0f} s; outputs in {out}"
+    )
     return summary

@@ -13,8 +13,12 @@ import json
 import os
 import sys
 
-FULL_MAP = dict(amplitudes=(50, 100, 125, 150, 200, 400), periods=(0.25, 0.5, 0.75, 1.0, 1.2, 1.5, 1.7, 2.0),
-                grains=5000, periods_per_job=10)
+FULL_MAP = dict(
+    amplitudes=(50, 100, 125, 150, 200, 400),
+    periods=(0.25, 0.5, 0.75, 1.0, 1.2, 1.5, 1.7, 2.0),
+    grains=5000,
+    periods_per_job=10,
+)
 
 
 def thesis_liquefies(amplitude, period):
@@ -38,21 +42,34 @@ def collect(folder):
         profile = s["profile"]
         amp = float(profile.split("amplitude=")[1].split(",")[0])
         period = float(profile.split("period=")[1].split(",")[0])
-        runs.append(dict(amplitude=amp, period=period, liquefied=s["liquefied"], peak=s["peak_mean_ratio"],
-                         grains=s["grains"], duration=s["duration"], wall=s["wall_seconds"]))
+        runs.append(
+            dict(
+                amplitude=amp,
+                period=period,
+                liquefied=s["liquefied"],
+                peak=s["peak_mean_ratio"],
+                grains=s["grains"],
+                duration=s["duration"],
+                wall=s["wall_seconds"],
+            )
+        )
     return runs
 
 
 def draw(runs, path):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for r in runs:
-        ax.scatter(r["period"], r["amplitude"], marker="o" if r["liquefied"] else "x", s=60,
-                   c="C3" if r["liquefied"] else "C0")
-        ax.annotate(f"{r['peak']:.2f}", (r["period"], r["amplitude"]), textcoords="offset points", xytext=(5, 4),
-                    fontsize=7)
+        ax.scatter(
+            r["period"], r["amplitude"], marker="o" if r["liquefied"] else "x", s=60, c="C3" if r["liquefied"] else "C0"
+        )
+        ax.annotate(
+            f"{r['peak']:.2f}", (r["period"], r["amplitude"]), textcoords="offset points", xytext=(5, 4), fontsize=7
+        )
     ax.scatter([], [], marker="o", c="C3", label="liquefied (grad H / i_c > 0.8)")
     ax.scatter([], [], marker="x", c="C0", label="stable")
     ax.set_xlabel("period T [s]")
@@ -87,8 +104,10 @@ def main(argv):
     grains = runs[0]["grains"]
     full_sim = sum(FULL_MAP["periods_per_job"] * T for T in FULL_MAP["periods"]) * len(FULL_MAP["amplitudes"])
     scale = FULL_MAP["grains"] / grains  # the step costs grow about linearly with the grains at this size
-    print(f"cost: {cost:.1f} wall s per simulated s at {grains} grains; the full map ({full_sim:g} simulated s at "
-          f"{FULL_MAP['grains']} grains) about {cost * scale * full_sim / 3600:.1f} h on one core")
+    print(
+        f"cost: {cost:.1f} wall s per simulated s at {grains} grains; the full map ({full_sim:g} simulated s at "
+        f"{FULL_MAP['grains']} grains) about {cost * scale * full_sim / 3600:.1f} h on one core"
+    )
     print(f"map: {out}")
 
 

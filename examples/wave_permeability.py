@@ -39,8 +39,10 @@ def liquefied_seconds(data):
     return float(np.sum(dt[ratio > seabed_wave.LIQUEFIED]))
 
 
-o = seabed_wave.options(sys.argv[1:], dict(amplitude=300.0, duration=10.0, factors="0.25,1,4",
-                                           shear_viscosity=1e-3, out="wave-permeability"))
+o = seabed_wave.options(
+    sys.argv[1:],
+    dict(amplitude=300.0, duration=10.0, factors="0.25,1,4", shear_viscosity=1e-3, out="wave-permeability"),
+)
 num = 1000 if o["quick"] else 5000
 sample = seabed_sample.prepare(num, 30.0)
 factors = [float(f) for f in o["factors"].split(",")]
@@ -54,18 +56,32 @@ for factor, shear in runs:
         settings["shear_viscosity"] = o["shear_viscosity"]
     summary = seabed_wave.run(name, load, sample, o["duration"], os.path.join(o["out"], name), 1.0, settings)
     porosity[name] = (np.asarray(plot.data["t"]), np.asarray(plot.data["porosity"]))
-    results.append(dict(name=name, permeability_factor=factor, viscous_shear=shear,
-                        shear_viscosity=o["shear_viscosity"] if shear else None,
-                        liquefied_seconds=liquefied_seconds(plot.data), final_porosity=summary["final_porosity"],
-                        settlement=summary["settlement"], max_axis_dx=summary["max_axis_dx"],
-                        peak_mean_ratio=summary["peak_mean_ratio"], wall_seconds=summary["wall_seconds"]))
-    print(f"{name}: liquefied for {results[-1]['liquefied_seconds']:.2f} s, n -> {summary['final_porosity']:.4f}, "
-          f"settlement {summary['settlement']:.4f} m, max axis dx {summary['max_axis_dx']:.4f} m")
+    results.append(
+        dict(
+            name=name,
+            permeability_factor=factor,
+            viscous_shear=shear,
+            shear_viscosity=o["shear_viscosity"] if shear else None,
+            liquefied_seconds=liquefied_seconds(plot.data),
+            final_porosity=summary["final_porosity"],
+            settlement=summary["settlement"],
+            max_axis_dx=summary["max_axis_dx"],
+            peak_mean_ratio=summary["peak_mean_ratio"],
+            wall_seconds=summary["wall_seconds"],
+        )
+    )
+    print(
+        f"{name}: liquefied for {results[-1]['liquefied_seconds']:.2f} s, n -> {summary['final_porosity']:.4f}, "
+        f"settlement {summary['settlement']:.4f} m, max axis dx {summary['max_axis_dx']:.4f} m"
+    )
 t0, n0 = porosity["K1"]
 t1, n1 = porosity["K1-shear"]
 shear_difference = float(np.max(np.abs(np.interp(t0, t1, n1) - n0)))
 print(f"viscous shear: largest |n_shear(t) - n(t)| = {shear_difference:.2e}")
 with open(os.path.join(o["out"], "permeability.json"), "w") as f:
-    json.dump(dict(amplitude=o["amplitude"], grains=num, runs=results, shear_porosity_difference=shear_difference),
-              f, indent=1)
+    json.dump(
+        dict(amplitude=o["amplitude"], grains=num, runs=results, shear_porosity_difference=shear_difference),
+        f,
+        indent=1,
+    )
 sys.exit(0)

@@ -78,6 +78,7 @@ for name, friction in BEDS:
     if not o["from"]:
         from yade import plot
         from pfv import waves
+
         load = waves.HalfWave(amplitude=0.0, rate=o["rate"], length=sample["box"][0])
         seabed_wave.run(f"ramp-{name}", load, sample, o["duration"], os.path.join(folder, name), 1.0)
         record = plot.data["t"], plot.data["KE"], plot.data["A"]
@@ -85,20 +86,35 @@ for name, friction in BEDS:
         record = read_record(os.path.join(folder, name))
     unstable[name] = instability_amplitudes(record[1], record[2], sample_mass(sample), sample["grains"]["d50"])
     if partial:
-        print(f"{name}: no summary.json, the run did not finish: its record ends at t = {record[0][-1]:.2f} s, "
-              f"A = {record[2][-1]:.0f} Pa ({num} grains assumed from --quick)")
-    print(f"{name} (n = {sample['porosity']:.3f}): unstable at A = {unstable[name][CRITERION]:.0f} Pa "
-          f"(thresholds {', '.join(f'{100 * f:g} %: {a:.0f} Pa' for f, a in unstable[name].items())})")
+        print(
+            f"{name}: no summary.json, the run did not finish: its record ends at t = {record[0][-1]:.2f} s, "
+            f"A = {record[2][-1]:.0f} Pa ({num} grains assumed from --quick)"
+        )
+    print(
+        f"{name} (n = {sample['porosity']:.3f}): unstable at A = {unstable[name][CRITERION]:.0f} Pa "
+        f"(thresholds {', '.join(f'{100 * f:g} %: {a:.0f} Pa' for f, a in unstable[name].items())})"
+    )
 if o["bed"]:
     sys.exit(0)  # one bed: the ratio comes from --from=DIR once both records are there
 ratios = {f: unstable["dense"][f] / unstable["loose"][f] for f in THRESHOLDS}
-print(f"instability amplitude dense / loose = {ratios[CRITERION]:.2f} (thesis: about 4; thresholds "
-      f"{', '.join(f'{100 * f:g} %: {r:.2f}' for f, r in ratios.items())})")
+print(
+    f"instability amplitude dense / loose = {ratios[CRITERION]:.2f} (thesis: about 4; thresholds "
+    f"{', '.join(f'{100 * f:g} %: {r:.2f}' for f, r in ratios.items())})"
+)
 with open(os.path.join(folder, "instability.json"), "w") as f:
-    json.dump(dict(criterion="rms grain velocity > threshold * sqrt(g d50)", threshold=CRITERION,
-                   unstable_amplitude={k: v[CRITERION] for k, v in unstable.items()},
-                   ratio=ratios[CRITERION], by_threshold={str(t): dict(dense=unstable["dense"][t],
-                                                                       loose=unstable["loose"][t], ratio=ratios[t])
-                                                          for t in THRESHOLDS},
-                   thesis=dict(dense=1500.0, ratio=4.0)), f, indent=1)
+    json.dump(
+        dict(
+            criterion="rms grain velocity > threshold * sqrt(g d50)",
+            threshold=CRITERION,
+            unstable_amplitude={k: v[CRITERION] for k, v in unstable.items()},
+            ratio=ratios[CRITERION],
+            by_threshold={
+                str(t): dict(dense=unstable["dense"][t], loose=unstable["loose"][t], ratio=ratios[t])
+                for t in THRESHOLDS
+            },
+            thesis=dict(dense=1500.0, ratio=4.0),
+        ),
+        f,
+        indent=1,
+    )
 sys.exit(0)

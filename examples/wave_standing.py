@@ -22,9 +22,17 @@ from pfv import waves  # noqa: E402
 utils.readParamsFromTable(amplitude=150.0, period=1.0, quick=0, duration=0.0, noTableOk=True)
 from yade.params import table  # noqa: E402
 
-o = seabed_wave.options(sys.argv[1:], dict(amplitude=float(table.amplitude), period=float(table.period),
-                                           duration=float(table.duration), friction=30.0, viscous_shear=0,
-                                           out=""))
+o = seabed_wave.options(
+    sys.argv[1:],
+    dict(
+        amplitude=float(table.amplitude),
+        period=float(table.period),
+        duration=float(table.duration),
+        friction=30.0,
+        viscous_shear=0,
+        out="",
+    ),
+)
 o["quick"] = o["quick"] or bool(int(table.quick))
 if utils.runningInBatch() and not o["out"]:  # a yade-batch job: its outputs go with the map's
     o["out"] = os.path.join("wave-map", O.tags["description"])

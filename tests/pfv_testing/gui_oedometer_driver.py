@@ -35,12 +35,21 @@ def tick():
         x, row = x + w.width(), max(row, w.height())
     try:
         from yade import plot, qt
+
         points = len(plot.data.get('Tv', []))
         views = len(qt.views())
     except Exception:  # noqa: BLE001
         points, views = -1, -1
-    ticks.append(dict(t=time.time(), iter=O.iter, running=bool(O.running), points=points, views=views,
-                      windows=sorted('%s:%s' % (type(w).__name__, w.windowTitle()) for w in windows)))
+    ticks.append(
+        dict(
+            t=time.time(),
+            iter=O.iter,
+            running=bool(O.running),
+            points=points,
+            views=views,
+            windows=sorted('%s:%s' % (type(w).__name__, w.windowTitle()) for w in windows),
+        )
+    )
     if O.running and points > 0:
         app.primaryScreen().grabWindow(0).save(os.path.join(out, 'screen.png'))
 

@@ -9,7 +9,7 @@ def jittered_lattice(n: int, seed: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """Centres and radii of n spheres on a unit cubic lattice (the first n sites, layer by layer in y),
     centres moved by up to 0.03 and radii 0.42 +- 10 %: no two spheres overlap."""
     side = round(n ** (1 / 3))
-    layers = math.ceil(n / side ** 2)
+    layers = math.ceil(n / side**2)
     i, j, k = np.meshgrid(np.arange(side), np.arange(layers), np.arange(side), indexing="ij")
     sites = np.column_stack([i.ravel(), j.ravel(), k.ravel()])[:n].astype(float) + 0.5
     rng = np.random.default_rng(seed)
@@ -23,6 +23,7 @@ def lattice_permeameter(n):
     jittered_lattice(n), flow along y (p = 100 on ymin, 0 on ymax), viscosity 1e-3, the walls at the spheres' extent,
     no automatic remesh, the multigrid solver."""
     import pfv
+
     pos, rad = jittered_lattice(n)
     lo, hi = (pos - rad[:, None]).min(0), (pos + rad[:, None]).max(0)
     walls = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
@@ -30,6 +31,6 @@ def lattice_permeameter(n):
     e.bnd_is_pressure = [False, False, True, True, False, False]
     e.bnd_value = [0, 0, 100.0, 0, 0, 0]
     e.viscosity = 1e-3
-    e.mesh_update_interval = 10 ** 9
+    e.mesh_update_interval = 10**9
     e.solver = 'multigrid'
     return e, pos, rad, walls

@@ -11,19 +11,35 @@ VISCOSITY = 1e-3
 
 def build_scene(n):
     from yade import O, utils
-    from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, Ig2_Box_Sphere_ScGeom,
-                              Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                              Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator)
+    from yade.wrapper import (
+        Bo1_Box_Aabb,
+        Bo1_Sphere_Aabb,
+        ForceResetter,
+        Ig2_Box_Sphere_ScGeom,
+        Ig2_Sphere_Sphere_ScGeom,
+        InsertionSortCollider,
+        InteractionLoop,
+        Ip2_FrictMat_FrictMat_FrictPhys,
+        Law2_ScGeom_FrictPhys_CundallStrack,
+        NewtonIntegrator,
+    )
+
     centres, radii = jittered_lattice(n, 1)
     lo, hi = (centres - radii[:, None]).min(axis=0), (centres + radii[:, None]).max(axis=0)
     O.reset()
     O.bodies.append(utils.aabbWalls([tuple(lo), tuple(hi)], thickness=0))
     O.bodies.append([utils.sphere(tuple(c), float(r), fixed=True) for c, r in zip(centres, radii)])
     O.dt = 1e-5
-    O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-                 InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
-                                 [Ip2_FrictMat_FrictMat_FrictPhys()], [Law2_ScGeom_FrictPhys_CundallStrack()]),
-                 NewtonIntegrator(damping=0.2)]
+    O.engines = [
+        ForceResetter(),
+        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys()],
+            [Law2_ScGeom_FrictPhys_CundallStrack()],
+        ),
+        NewtonIntegrator(damping=0.2),
+    ]
     for _ in range(2):  # the collider's first runs, before any engine is timed
         O.step()
     return tuple(hi - lo)
@@ -41,7 +57,7 @@ def make_flow(kind):
     flow.boundaryUseMaxMin = [False] * 6
     flow.viscosity = VISCOSITY
     flow.slipBoundary = False
-    flow.meshUpdateInterval = 10 ** 9
+    flow.meshUpdateInterval = 10**9
     flow.defTolerance = 0.0
     if kind == "yade":
         flow.useSolver = 3
@@ -56,6 +72,7 @@ def make_flow(kind):
 def insert(flow):
     from yade import O
     from yade.wrapper import NewtonIntegrator
+
     engines = [e for e in O.engines]
     i = [k for k, e in enumerate(engines) if isinstance(e, NewtonIntegrator)][0]
     O.engines = engines[:i] + [flow] + engines[i:]
@@ -63,5 +80,6 @@ def insert(flow):
 
 def remove_flows():
     from yade import O
+
     O.engines = [e for e in O.engines if "FlowEngine" not in type(e).__name__]
     gc.collect()

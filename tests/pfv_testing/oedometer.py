@@ -34,7 +34,7 @@ def run_and_check(args, thresholds, extra_check=None):
         ok = math.isfinite(v) and lo <= v <= hi
         failures += not ok
         print('%s %s = %.4f (allowed %g .. %g)' % ('ok  ' if ok else 'FAIL', name, v, lo, hi))
-    for ok, message in (extra_check(s) if extra_check else []):
+    for ok, message in extra_check(s) if extra_check else []:
         failures += not ok
         print('%s %s' % ('ok  ' if ok else 'FAIL', message))
     print('%d failed; outputs in %s' % (failures, out))

@@ -50,9 +50,11 @@ def main(argv):
         ns['FlowEngine'] = pfv.FlowEngine
         if '--thesis-wall-throats' in argv:
             import functools
+
             ns['FlowEngine'] = functools.partial(pfv.FlowEngine, yade_wall_throat_factor=False)
     try:  # no GUI: plot.plot() would try to open a window
         from yade import plot
+
         plot.plot = lambda *a, **k: None
     except Exception:
         pass

@@ -23,10 +23,21 @@ import tempfile
 
 from pfv_testing import paths
 from yade import O, pack, utils
-from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,
-                          Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                          Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator,
-                          GlobalStiffnessTimeStepper, TriaxialStressController)
+from yade.wrapper import (
+    Bo1_Box_Aabb,
+    Bo1_Sphere_Aabb,
+    ForceResetter,
+    FrictMat,
+    Ig2_Box_Sphere_ScGeom,
+    Ig2_Sphere_Sphere_ScGeom,
+    InsertionSortCollider,
+    InteractionLoop,
+    Ip2_FrictMat_FrictMat_FrictPhys,
+    Law2_ScGeom_FrictPhys_CundallStrack,
+    NewtonIntegrator,
+    GlobalStiffnessTimeStepper,
+    TriaxialStressController,
+)
 
 CACHE_DIR = os.environ.get('PFV_SCENE_CACHE', '/tmp/pfv-yade-scenes')
 DATA_DIR = paths.PACKINGS
@@ -52,14 +63,23 @@ def _compact(num, seed, box, stress=-1.0e4, young=1.0e6, maxIter=200000):
     sp = pack.SpherePack()
     sp.makeCloud(mn, mx, -1, 0.3333, num, False, 0.95, seed=seed)
     sp.toSimulation(material='spheres')
-    triax = TriaxialStressController(maxMultiplier=1. + 2e4 / young, finalMaxMultiplier=1. + 2e3 / young, thickness=0,
-                                     stressMask=7, max_vel=0.005, internalCompaction=True)
+    triax = TriaxialStressController(
+        maxMultiplier=1.0 + 2e4 / young,
+        finalMaxMultiplier=1.0 + 2e3 / young,
+        thickness=0,
+        stressMask=7,
+        max_vel=0.005,
+        internalCompaction=True,
+    )
     triax.goal1 = triax.goal2 = triax.goal3 = stress
     O.engines = [
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-        InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                        [Law2_ScGeom_FrictPhys_CundallStrack()]),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys()],
+            [Law2_ScGeom_FrictPhys_CundallStrack()],
+        ),
         GlobalStiffnessTimeStepper(active=1, timeStepUpdateInterval=100, timestepSafetyCoefficient=0.8),
         triax,
         NewtonIntegrator(damping=0.2),
@@ -72,10 +92,11 @@ def _compact(num, seed, box, stress=-1.0e4, young=1.0e6, maxIter=200000):
             break
     else:
         raise RuntimeError('scenes: compaction did not converge in %d iterations' % maxIter)
-    print('scenes: compacted %d spheres in %d iterations, mean stress %g, unbalanced force %g'
-          % (num, O.iter, triax.meanStress, utils.unbalancedForce()))
-    out = [(b.state.pos[0], b.state.pos[1], b.state.pos[2], b.shape.radius)
-           for b in O.bodies if b.id >= 6]
+    print(
+        'scenes: compacted %d spheres in %d iterations, mean stress %g, unbalanced force %g'
+        % (num, O.iter, triax.meanStress, utils.unbalancedForce())
+    )
+    out = [(b.state.pos[0], b.state.pos[1], b.state.pos[2], b.shape.radius) for b in O.bodies if b.id >= 6]
     O.reset()
     return out
 
@@ -94,8 +115,9 @@ def packing(num=1000, seed=1, box=(1.0, 1.0, 1.0), regenerate=False):
         os.makedirs(CACHE_DIR, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=CACHE_DIR, prefix='.tmp-')
         with os.fdopen(fd, 'w') as f:
-            f.write('# pfv permeameter packing: num=%d seed=%d box=%r; x y z r (repr floats)\n'
-                    % (num, seed, tuple(box)))
+            f.write(
+                '# pfv permeameter packing: num=%d seed=%d box=%r; x y z r (repr floats)\n' % (num, seed, tuple(box))
+            )
             for s in spheres:
                 f.write(' '.join(repr(float(v)) for v in s) + '\n')
         os.chmod(tmp, 0o644)
@@ -135,8 +157,11 @@ def build_permeameter(num=1000, seed=1, box=(1.0, 1.0, 1.0), frozen=True, reset=
     O.engines = [
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-        InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                        [Law2_ScGeom_FrictPhys_CundallStrack()]),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys()],
+            [Law2_ScGeom_FrictPhys_CundallStrack()],
+        ),
         NewtonIntegrator(damping=0, label='newton'),
     ]
     O.dt = 1e-5
@@ -153,8 +178,7 @@ def insert_flow(flow):
     return i
 
 
-def configure_flow(flow, axis=1, dp=1.0, p_out=0.0, viscosity=1.0, permeabilityFactor=1.0, useWalls=True,
-                   **extra):
+def configure_flow(flow, axis=1, dp=1.0, p_out=0.0, viscosity=1.0, permeabilityFactor=1.0, useWalls=True, **extra):
     """Common settings for a permeameter, for YADE's FlowEngine or any object with the same attribute names.
 
     Pressure p_out+dp on the min wall of `axis` (0=x, 1=y, 2=z), p_out on the max wall, the four other walls

@@ -28,4 +28,5 @@ def median(xs):
 def yade_step():
     """Seconds of wall time of one O.step()."""
     from yade import O
+
     return wall(O.step)

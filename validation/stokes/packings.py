@@ -24,9 +24,11 @@ def centred9(d_over_d):
     The central sphere touches the eight for d/D = sqrt(3) - 1 = 0.732; above that it overlaps them.
     """
     p = cubic8()
-    return {"name": "centred9_%.2f" % d_over_d,
-            "centres": np.vstack([p["centres"], [0.5, 0.5, 0.5]]),
-            "radii": np.append(p["radii"], 0.25 * d_over_d)}
+    return {
+        "name": "centred9_%.2f" % d_over_d,
+        "centres": np.vstack([p["centres"], [0.5, 0.5, 0.5]]),
+        "radii": np.append(p["radii"], 0.25 * d_over_d),
+    }
 
 
 def shrunk(packing, shrink):
@@ -41,19 +43,25 @@ def _energy(flat, r):
     """Sum of squared overlaps (sphere pairs and walls) and its gradient in the centres."""
     x = flat.reshape(-1, 3)
     d = x[:, None, :] - x[None, :, :]
-    dist = np.sqrt((d ** 2).sum(-1)) + np.eye(len(r))
+    dist = np.sqrt((d**2).sum(-1)) + np.eye(len(r))
     pair = np.triu(np.maximum(r[:, None] + r[None, :] - dist, 0.0), 1)
     pair = pair + pair.T
     low = np.maximum(r[:, None] - x, 0.0)
     high = np.maximum(x + r[:, None] - 1.0, 0.0)
-    energy = 0.5 * (pair ** 2).sum() / 2 + 0.5 * ((low ** 2).sum() + (high ** 2).sum())
+    energy = 0.5 * (pair**2).sum() / 2 + 0.5 * ((low**2).sum() + (high**2).sum())
     grad = -((pair / dist)[:, :, None] * d).sum(1) * 1.0 - low + high
     return energy, grad.ravel()
 
 
 def _minimise(x, r):
-    res = minimize(_energy, x.ravel(), args=(r,), jac=True, method="L-BFGS-B",
-                   options={"maxiter": 5000, "ftol": 1e-30, "gtol": 1e-14})
+    res = minimize(
+        _energy,
+        x.ravel(),
+        args=(r,),
+        jac=True,
+        method="L-BFGS-B",
+        options={"maxiter": 5000, "ftol": 1e-30, "gtol": 1e-14},
+    )
     return res.x.reshape(-1, 3), res.fun
 
 
@@ -70,7 +78,7 @@ def random_packing(n, ratio, seed, tolerance=1e-6):
     shape = rng.uniform(ratio, 1.0, n)
     x = rng.uniform(0.0, 1.0, (n, 3))
     low = 0.0
-    high = (3.0 * 0.7 / (4.0 * np.pi * (shape ** 3).sum())) ** (1.0 / 3.0)  # solid fraction 0.7
+    high = (3.0 * 0.7 / (4.0 * np.pi * (shape**3).sum())) ** (1.0 / 3.0)  # solid fraction 0.7
     good = x
     for _ in range(40):
         scale = 0.5 * (low + high)
@@ -110,6 +118,7 @@ if __name__ == "__main__":
     # root): a random packing for run.py's case NAME (random<N>, or random<N>s<SEED> for further seeds)
     import os
     import sys
+
     n, ratio, seed, path = int(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
     packing = random_packing(n, ratio, seed)
     packing["name"] = os.path.splitext(os.path.basename(path))[0]

@@ -32,6 +32,12 @@ def run(packing, variant, dp=1.0, mu=1.0):
     for w, name in enumerate(FACES):
         forces[name] = {"pressure": pressure[len(radii) + w].tolist(), "viscous": viscous[len(radii) + w].tolist()}
     total = np.asarray(e.forces())
-    return {"variant": variant, "flux_in": -q_in, "flux_out": q_out, "kappa": mu * q_out / dp,
-            "cells": e.n_cells(), "forces": forces,
-            "split_error": float(np.abs(pressure + viscous - total).max())}
+    return {
+        "variant": variant,
+        "flux_in": -q_in,
+        "flux_out": q_out,
+        "kappa": mu * q_out / dp,
+        "cells": e.n_cells(),
+        "forces": forces,
+        "split_error": float(np.abs(pressure + viscous - total).max()),
+    }

@@ -18,18 +18,26 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 
 # thesis Table 3.2 (no-slip lateral faces, forces / (S dP)): FEM, PFV
 THESIS_TABLE_3_2 = {
-    "big sphere, viscous y": (1.51e-2, 1.06e-2), "big sphere, pressure y": (9.09e-2, 9.64e-2),
-    "big sphere, total y": (1.06e-1, 1.07e-1), "small sphere, viscous y": (9.38e-3, 5.83e-3),
-    "small sphere, pressure y": (5.17e-2, 5.72e-2), "small sphere, total y": (6.04e-2, 6.30e-2),
-    "boundary x=0, viscous y": (2.27e-2, 2.03e-2), "boundary x=0, pressure x": (4.98e-1, 5.00e-1),
+    "big sphere, viscous y": (1.51e-2, 1.06e-2),
+    "big sphere, pressure y": (9.09e-2, 9.64e-2),
+    "big sphere, total y": (1.06e-1, 1.07e-1),
+    "small sphere, viscous y": (9.38e-3, 5.83e-3),
+    "small sphere, pressure y": (5.17e-2, 5.72e-2),
+    "small sphere, total y": (6.04e-2, 6.30e-2),
+    "boundary x=0, viscous y": (2.27e-2, 2.03e-2),
+    "boundary x=0, pressure x": (4.98e-1, 5.00e-1),
     "solid phase, total y": (1 - 5.56e-4, 1 + 1.18e-4),
 }
 
 
 # (model key, FEM key, label) of the ratios kappa_model / kappa_FEM reported, same lateral condition
-RATIOS = (("pfv_slip", "fem_sym", "PFV slip, thesis formula"), ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor"),
-          ("yade_slip", "fem_sym", "YADE slip"), ("pfv_noslip", "fem_noslip", "PFV no-slip"),
-          ("yade_noslip", "fem_noslip", "YADE no-slip"))
+RATIOS = (
+    ("pfv_slip", "fem_sym", "PFV slip, thesis formula"),
+    ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor"),
+    ("yade_slip", "fem_sym", "YADE slip"),
+    ("pfv_noslip", "fem_noslip", "PFV no-slip"),
+    ("yade_noslip", "fem_noslip", "YADE no-slip"),
+)
 
 # the thesis' mean kappa_HR / kappa_FEM over its packings (section 3.5.3, Fig. 3.12)
 THESIS_MEAN = {"symmetry": 1.01, "noslip": 0.78}
@@ -89,20 +97,39 @@ def balance(solution):
 
 
 def convergence_table(results):
-    lines = ["| case | surface size | DOFs | folded cells | κ_FEM sym | change | κ_FEM no-slip | change "
-             "| solve (s) sym / no-slip | \\|Q_in − Q_out\\| / Q sym / no-slip |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| case | surface size | DOFs | folded cells | κ_FEM sym | change | κ_FEM no-slip | change "
+        "| solve (s) sym / no-slip | \\|Q_in − Q_out\\| / Q sym / no-slip |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in results:
         prev = None
         for lv in r["fem"]:
             s, n = lv["symmetry"], lv["noslip"]
             cs = "" if prev is None else "%+.2f %%" % (100 * (s["kappa"] / prev[0] - 1))
             cn = "" if prev is None else "%+.2f %%" % (100 * (n["kappa"] / prev[1] - 1))
-            folded = "%d of %s" % (lv["tangled_cells"], "{:,}".format(s["cells"]).replace(",", " ")) \
-                if "tangled_cells" in lv else "–"
-            lines.append("| %s | %.3f | %s | %s | %.4e | %s | %.4e | %s | %.0f / %.0f | %.1e / %.1e |" % (
-                r["case"], lv["surface"], "{:,}".format(s["dofs"]).replace(",", " "), folded, s["kappa"], cs,
-                n["kappa"], cn, s["seconds_solve"], n["seconds_solve"], balance(s), balance(n)))
+            folded = (
+                "%d of %s" % (lv["tangled_cells"], "{:,}".format(s["cells"]).replace(",", " "))
+                if "tangled_cells" in lv
+                else "–"
+            )
+            lines.append(
+                "| %s | %.3f | %s | %s | %.4e | %s | %.4e | %s | %.0f / %.0f | %.1e / %.1e |"
+                % (
+                    r["case"],
+                    lv["surface"],
+                    "{:,}".format(s["dofs"]).replace(",", " "),
+                    folded,
+                    s["kappa"],
+                    cs,
+                    n["kappa"],
+                    cn,
+                    s["seconds_solve"],
+                    n["seconds_solve"],
+                    balance(s),
+                    balance(n),
+                )
+            )
             prev = (s["kappa"], n["kappa"])
         if len(r["fem"]) >= 3:
             cells = []
@@ -128,15 +155,22 @@ RESOLVED = 0.01  # |Q_in - Q_out| / Q of the finest mesh below which a case ente
 
 
 def unresolved(results):
-    return [r["case"] for r in results
-            if r["fem"] and max(balance(r["fem"][-1][lat]) for lat in ("symmetry", "noslip")) > RESOLVED]
+    return [
+        r["case"]
+        for r in results
+        if r["fem"] and max(balance(r["fem"][-1][lat]) for lat in ("symmetry", "noslip")) > RESOLVED
+    ]
 
 
 def model_kappas(r):
     """kappa of PFV's three wall variants and YADE's two, keyed as in RATIOS."""
-    return {"pfv_noslip": r["pfv"]["noslip"]["kappa"], "pfv_slip": r["pfv"]["slip"]["kappa"],
-            "pfv_slip_yade": r["pfv"]["slip_yade"]["kappa"],
-            "yade_noslip": yade_kappa(r, "noslip"), "yade_slip": yade_kappa(r, "slip")}
+    return {
+        "pfv_noslip": r["pfv"]["noslip"]["kappa"],
+        "pfv_slip": r["pfv"]["slip"]["kappa"],
+        "pfv_slip_yade": r["pfv"]["slip_yade"]["kappa"],
+        "yade_noslip": yade_kappa(r, "noslip"),
+        "yade_slip": yade_kappa(r, "slip"),
+    }
 
 
 def kappa_rows(results):
@@ -146,29 +180,52 @@ def kappa_rows(results):
             continue
         ks, _, es, _ = fem_estimate(r["fem"], "symmetry")
         kn, _, en, _ = fem_estimate(r["fem"], "noslip")
-        rows.append({
-            "case": r["case"], "n": r["n"], "porosity": r["porosity"], "shrink": r["shrink"],
-            # the reference: the Richardson estimate where three levels give one, else the finest mesh
-            "fem_sym": es if np.isfinite(es) else ks, "fem_noslip": en if np.isfinite(en) else kn,
-            "fem_sym_finest": ks, "fem_noslip_finest": kn, **model_kappas(r)})
+        rows.append(
+            {
+                "case": r["case"],
+                "n": r["n"],
+                "porosity": r["porosity"],
+                "shrink": r["shrink"],
+                # the reference: the Richardson estimate where three levels give one, else the finest mesh
+                "fem_sym": es if np.isfinite(es) else ks,
+                "fem_noslip": en if np.isfinite(en) else kn,
+                "fem_sym_finest": ks,
+                "fem_noslip_finest": kn,
+                **model_kappas(r),
+            }
+        )
     return rows
 
 
 def kappa_table(rows):
     """kappa_FEM and each model's ratio to it, per case; the FEM's extrapolation spread beside it
     where the rows carry one (contact_rows)."""
+
     def fem(w, key):
         spread = w.get(key + "_spread")
         return "%.4e" % w[key] + ("" if spread is None else " ± %.1f %%" % (100 * abs(spread)))
 
-    lines = ["| case | porosity | κ_FEM sym | PFV slip, thesis / FEM | PFV slip, YADE factor / FEM "
-             "| YADE slip / FEM | κ_FEM no-slip | PFV no-slip / FEM | YADE no-slip / FEM |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| case | porosity | κ_FEM sym | PFV slip, thesis / FEM | PFV slip, YADE factor / FEM "
+        "| YADE slip / FEM | κ_FEM no-slip | PFV no-slip / FEM | YADE no-slip / FEM |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for w in rows:
         sym, ns = w["fem_sym"], w["fem_noslip"]
-        lines.append("| %s | %.3f | %s | **%.3f** | %.3f | %.3f | %s | %.3f | %.3f |" % (
-            w["case"], w["porosity"], fem(w, "fem_sym"), w["pfv_slip"] / sym, w["pfv_slip_yade"] / sym,
-            w["yade_slip"] / sym, fem(w, "fem_noslip"), w["pfv_noslip"] / ns, w["yade_noslip"] / ns))
+        lines.append(
+            "| %s | %.3f | %s | **%.3f** | %.3f | %.3f | %s | %.3f | %.3f |"
+            % (
+                w["case"],
+                w["porosity"],
+                fem(w, "fem_sym"),
+                w["pfv_slip"] / sym,
+                w["pfv_slip_yade"] / sym,
+                w["yade_slip"] / sym,
+                fem(w, "fem_noslip"),
+                w["pfv_noslip"] / ns,
+                w["yade_noslip"] / ns,
+            )
+        )
     return "\n".join(lines)
 
 
@@ -183,14 +240,22 @@ def summary(rows):
             q = q[np.isfinite(q)]
             if len(q):
                 worst = q[np.argmax(np.abs(q - 1))]
-                out.append("| %s | %s | %.3f | %.1f %% | %.3f | %d |" % (
-                    label, group, q.mean(), 100 * np.mean(np.abs(q - 1)), worst, len(q)))
-    return "\n".join(["| κ / κ_FEM | packings | mean | mean \\|κ/κ_FEM − 1\\| | furthest from 1 | cases |",
-                      "|---|---|---|---|---|---|"] + out)
+                out.append(
+                    "| %s | %s | %.3f | %.1f %% | %.3f | %d |"
+                    % (label, group, q.mean(), 100 * np.mean(np.abs(q - 1)), worst, len(q))
+                )
+    return "\n".join(
+        [
+            "| κ / κ_FEM | packings | mean | mean \\|κ/κ_FEM − 1\\| | furthest from 1 | cases |",
+            "|---|---|---|---|---|---|",
+        ]
+        + out
+    )
 
 
 def force_quantities(f):
     """The quantities of thesis Table 3.2 from one force dictionary (pfv_model / solve.py), / (S dP)."""
+
     def part(name, which, axis):
         if which == "total":
             return f[name]["pressure"][axis] + f[name]["viscous"][axis]
@@ -201,7 +266,8 @@ def force_quantities(f):
 
     solids = [k for k in f if k.startswith("sphere") or k in ("xmin", "xmax", "zmin", "zmax")]
     return {
-        "big sphere, viscous y": big("viscous"), "big sphere, pressure y": big("pressure"),
+        "big sphere, viscous y": big("viscous"),
+        "big sphere, pressure y": big("pressure"),
         "big sphere, total y": big("total"),
         "small sphere, viscous y": part("sphere8", "viscous", 1),
         "small sphere, pressure y": part("sphere8", "pressure", 1),
@@ -222,8 +288,9 @@ def forces_072(results):
         return ""
     fem = force_quantities(r["fem"][-1]["noslip"]["forces"])
     pfv = force_quantities(r["pfv"]["noslip"]["forces"])
-    shrinks = sorted((x["shrink"], x) for x in results
-                     if x["case"].partition("@")[0] == "centred9_0.72" and x["fem"])[::-1]
+    shrinks = sorted((x["shrink"], x) for x in results if x["case"].partition("@")[0] == "centred9_0.72" and x["fem"])[
+        ::-1
+    ]
     touching = by_case.get("centred9_0.72@0")
     contact = None
     if len(shrinks) >= 3 and touching is not None:
@@ -254,12 +321,18 @@ def centre_sphere_table(results):
     """The centre sphere of the 9-sphere series against d/D (thesis Fig. 3.15): its force along the
     flow, total and viscous part, FEM (finest mesh) and PFV, both lateral conditions (PFV's slip walls
     with YADE's factor), at the 1 % shrink."""
-    series = sorted((float(r["case"].split("_")[1]), r) for r in results
-                    if r["case"].startswith("centred9_") and "@" not in r["case"] and r["fem"])
+    series = sorted(
+        (float(r["case"].split("_")[1]), r)
+        for r in results
+        if r["case"].startswith("centred9_") and "@" not in r["case"] and r["fem"]
+    )
     if not series:
         return ""
-    lines = ["| d/D | FEM total, sym [10⁻³ S ΔP] | PFV / FEM, sym | FEM total, no-slip [10⁻³ S ΔP] "
-             "| PFV / FEM, no-slip | viscous part FEM / PFV, no-slip [10⁻³ S ΔP] |", "|---|---|---|---|---|---|"]
+    lines = [
+        "| d/D | FEM total, sym [10⁻³ S ΔP] | PFV / FEM, sym | FEM total, no-slip [10⁻³ S ΔP] "
+        "| PFV / FEM, no-slip | viscous part FEM / PFV, no-slip [10⁻³ S ΔP] |",
+        "|---|---|---|---|---|---|",
+    ]
     for x, r in series:
         cells = []
         for lateral, variant in (("symmetry", "slip_yade"), ("noslip", "noslip")):
@@ -277,17 +350,21 @@ def figure(rows, contact, path):
     (contact_rows, filled markers) where the packing's shrink series exists, else at the 1 % shrink
     (open markers)."""
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     touching = {w["case"]: w for w in contact}
     shrunk = {w["case"]: w for w in rows if "@" not in w["case"]}
     chosen = {c: touching.get(c, w) for c, w in shrunk.items()}
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
-    styles = (("pfv_slip", "fem_sym", "PFV slip, thesis formula", "o", "-"),
-              ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor", "s", "--"),
-              ("yade_slip", "fem_sym", "YADE slip", "x", ":"),
-              ("pfv_noslip", "fem_noslip", "PFV no-slip", "^", "-"),
-              ("yade_noslip", "fem_noslip", "YADE no-slip", "+", ":"))
+    styles = (
+        ("pfv_slip", "fem_sym", "PFV slip, thesis formula", "o", "-"),
+        ("pfv_slip_yade", "fem_sym", "PFV slip, YADE factor", "s", "--"),
+        ("yade_slip", "fem_sym", "YADE slip", "x", ":"),
+        ("pfv_noslip", "fem_noslip", "PFV no-slip", "^", "-"),
+        ("yade_noslip", "fem_noslip", "YADE no-slip", "+", ":"),
+    )
     series = sorted([c for c in chosen if c.startswith("centred9_")], key=lambda c: float(c.split("_")[1]))
     x = np.array([float(c.split("_")[1]) for c in series])
     filled = np.array([c in touching for c in series], dtype=bool)
@@ -301,8 +378,13 @@ def figure(rows, contact, path):
         a.plot(x[filled], y[filled], marker, color=colour, ls="none")
         a.plot(x[~filled], y[~filled], marker, color=colour, ls="none", mfc="none")
         for p, c in zip(pos, packs):
-            b.plot(p + (i - 2) * 0.06, chosen[c][key] / chosen[c][ref], marker, color=colour,
-                   mfc=colour if c in touching else "none")
+            b.plot(
+                p + (i - 2) * 0.06,
+                chosen[c][key] / chosen[c][ref],
+                marker,
+                color=colour,
+                mfc=colour if c in touching else "none",
+            )
     a.axhline(1, color="k", lw=0.5)
     a.set_xlabel("d/D (9-sphere packing)")
     a.set_ylabel("κ / κ_FEM (same lateral condition)")
@@ -318,8 +400,9 @@ def figure(rows, contact, path):
     b.set_xlabel("packing (number of spheres)")
     b.set_ylabel("κ / κ_FEM")
     if not filled.all() or any(c not in touching for c in packs):
-        fig.suptitle("filled: touching spheres (FEM extrapolated in the shrink); open: spheres shrunk by 1 %",
-                     fontsize=9)
+        fig.suptitle(
+            "filled: touching spheres (FEM extrapolated in the shrink); open: spheres shrunk by 1 %", fontsize=9
+        )
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
@@ -349,8 +432,13 @@ def contact_rows(rows, results):
         if base not in models:
             continue
         shrinks = sorted(v, reverse=True)
-        row = {"case": base, "n": models[base]["n"], "porosity": models[base]["porosity"], "shrink": 0.0,
-               **model_kappas(models[base])}
+        row = {
+            "case": base,
+            "n": models[base]["n"],
+            "porosity": models[base]["porosity"],
+            "shrink": 0.0,
+            **model_kappas(models[base]),
+        }
         for key in ("fem_sym", "fem_noslip"):
             values = [v[x][key] for x in shrinks]
             limit, order = richardson(shrinks, values, MIN_SHRINK_ORDER)
@@ -369,9 +457,11 @@ def shrink_table(rows, contact):
     if not series:
         return ""
     columns = sorted({s for v in series.values() for s in v}, reverse=True)
-    lines = ["| case | quantity | %s | touching | at %g %% / touching |" % (
-        " | ".join("shrink %g %%" % (100 * s) for s in columns), 100 * columns[0]),
-        "|---|---|%s---|---|" % ("---|" * len(columns))]
+    lines = [
+        "| case | quantity | %s | touching | at %g %% / touching |"
+        % (" | ".join("shrink %g %%" % (100 * s) for s in columns), 100 * columns[0]),
+        "|---|---|%s---|---|" % ("---|" * len(columns)),
+    ]
     for base, v in series.items():
         touch = at_contact.get(base)
         for key, ref, label in (("fem_sym", None, "κ_FEM sym"), ("fem_noslip", None, "κ_FEM no-slip")) + RATIOS:
@@ -385,21 +475,41 @@ def shrink_table(rows, contact):
                 limit = touch[key]
                 how = "%.4e (q = %.1f, ± %.2f %%)" % (limit, touch[key + "_order"], 100 * abs(touch[key + "_spread"]))
             first = v[columns[0]][key] / (v[columns[0]][ref] if ref else 1) if columns[0] in v else float("nan")
-            lines.append("| %s | %s | %s | %s | %s |" % (
-                base, label, " | ".join(cells), how,
-                "%+.1f %%" % (100 * (first / limit - 1)) if np.isfinite(limit) and np.isfinite(first) else "–"))
+            lines.append(
+                "| %s | %s | %s | %s | %s |"
+                % (
+                    base,
+                    label,
+                    " | ".join(cells),
+                    how,
+                    "%+.1f %%" % (100 * (first / limit - 1)) if np.isfinite(limit) and np.isfinite(first) else "–",
+                )
+            )
     return "\n".join(lines)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--results", default=",".join(os.path.join(HERE, "results", f)
-                                                  for f in ("stokes_results.json", "stokes_series.json",
-                                                            "stokes_shrink.json", "stokes_random200.json",
-                                                            "stokes_random54.json", "stokes_random_more.json",
-                                                            "stokes_random54s2.json", "stokes_shrink_random.json",
-                                                            "stokes_shrink_random54.json", "stokes_shrink_series.json",
-                                                            "stokes_shrink_series2.json", "stokes_contact.json")))
+    ap.add_argument(
+        "--results",
+        default=",".join(
+            os.path.join(HERE, "results", f)
+            for f in (
+                "stokes_results.json",
+                "stokes_series.json",
+                "stokes_shrink.json",
+                "stokes_random200.json",
+                "stokes_random54.json",
+                "stokes_random_more.json",
+                "stokes_random54s2.json",
+                "stokes_shrink_random.json",
+                "stokes_shrink_random54.json",
+                "stokes_shrink_series.json",
+                "stokes_shrink_series2.json",
+                "stokes_contact.json",
+            )
+        ),
+    )
     ap.add_argument("--figure", default=os.path.join(ROOT, "doc", "figures", "stokes-kappa.png"))
     args = ap.parse_args()
     results = {}

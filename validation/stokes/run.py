@@ -59,8 +59,11 @@ def case_packing(name):
 
 
 def all_cases():
-    return ["cubic8", "centred9_0.72", "random25", "random54"] + \
-        ["centred9_%.2f" % x for x in D_OVER_D if x != 0.72] + ["cubic8@0.005", "centred9_0.72@0.005"]
+    return (
+        ["cubic8", "centred9_0.72", "random25", "random54"]
+        + ["centred9_%.2f" % x for x in D_OVER_D if x != 0.72]
+        + ["cubic8@0.005", "centred9_0.72@0.005"]
+    )
 
 
 YADE_JITTER = 1e-6
@@ -84,8 +87,13 @@ def run_yade(packing):
         src, dst = os.path.join(tmp, "packing.json"), os.path.join(tmp, "yade.json")
         packings.save(jittered(packing), src)
         env = dict(os.environ, OMP_NUM_THREADS="1")
-        done = subprocess.run(["yade-double", "-n", "-x", os.path.join(HERE, "yade_model.py"), src, dst],
-                              env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        done = subprocess.run(
+            ["yade-double", "-n", "-x", os.path.join(HERE, "yade_model.py"), src, dst],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
         if done.returncode != 0 or not os.path.exists(dst):
             return {"error": done.stdout[-2000:]}
         with open(dst) as f:
@@ -106,8 +114,15 @@ def fem_case(packing, surface, laterals=("symmetry", "noslip"), method="direct",
 
 def run_case(name, levels, with_yade=True, log=print, save=lambda r: None, method="direct", also_minres=False):
     packing = case_packing(name)
-    result = {"case": name, "n": len(packing["radii"]), "shrink": packing["shrink"],
-              "porosity": packings.porosity(packing), "fem": [], "pfv": {}, "yade": None}
+    result = {
+        "case": name,
+        "n": len(packing["radii"]),
+        "shrink": packing["shrink"],
+        "porosity": packings.porosity(packing),
+        "fem": [],
+        "pfv": {},
+        "yade": None,
+    }
     for variant in pfv_model.VARIANTS:
         result["pfv"][variant] = pfv_model.run(packing, variant)
     if with_yade:
@@ -116,9 +131,19 @@ def run_case(name, levels, with_yade=True, log=print, save=lambda r: None, metho
         level = fem_case(packing, surface, method=method, also_minres=also_minres)
         result["fem"].append(level)
         save(result)
-        log("%-22s surface %.3f  dofs %8d  kappa sym %.5e  noslip %.5e  mesh %.0f s  solve %.0f + %.0f s" % (
-            name, surface, level["symmetry"]["dofs"], level["symmetry"]["kappa"], level["noslip"]["kappa"],
-            level["seconds_mesh"], level["symmetry"]["seconds_solve"], level["noslip"]["seconds_solve"]))
+        log(
+            "%-22s surface %.3f  dofs %8d  kappa sym %.5e  noslip %.5e  mesh %.0f s  solve %.0f + %.0f s"
+            % (
+                name,
+                surface,
+                level["symmetry"]["dofs"],
+                level["symmetry"]["kappa"],
+                level["noslip"]["kappa"],
+                level["seconds_mesh"],
+                level["symmetry"]["seconds_solve"],
+                level["noslip"]["seconds_solve"],
+            )
+        )
     return result
 
 
@@ -129,11 +154,15 @@ def quick_numbers():
     out = {"surface": QUICK_SURFACE, "shrink": SHRINK, "kappa_minres": fem["symmetry_minres"]["kappa"]}
     for lateral in ("symmetry", "noslip"):
         s = fem[lateral]
-        fy = [s["forces"]["sphere%d" % k]["pressure"][1] + s["forces"]["sphere%d" % k]["viscous"][1]
-              for k in range(8)]
+        fy = [s["forces"]["sphere%d" % k]["pressure"][1] + s["forces"]["sphere%d" % k]["viscous"][1] for k in range(8)]
         balance = abs(s["flux_in"] - s["flux_out"]) / s["flux_in"]
-        out[lateral] = {"kappa": s["kappa"], "dofs": s["dofs"], "flux_balance": balance,
-                        "sphere_force_y": float(np.mean(fy)), "sphere_force_spread": float(np.ptp(fy))}
+        out[lateral] = {
+            "kappa": s["kappa"],
+            "dofs": s["dofs"],
+            "flux_balance": balance,
+            "sphere_force_y": float(np.mean(fy)),
+            "sphere_force_spread": float(np.ptp(fy)),
+        }
     out["cells"] = fem["symmetry"]["cells"]
     out["tangled_cells"] = fem["tangled_cells"]
     out["pfv"] = {v: r["pfv"][v]["kappa"] for v in pfv_model.VARIANTS}
@@ -144,17 +173,35 @@ def compare_quick(now, ref):
     """Rows (what, value, reference, ok). The FEM on the same mesh and solver: kappa and the mean
     sphere force to 1e-6 relative; the flux balance between the two pressure faces below 1e-4 (a mesh
     with folded curved cells misses it by 30x); at most 0.1 % of the cells folded; PFV's kappa to 1e-9."""
-    rows = [("FEM folded cells / cells", now["tangled_cells"] / now["cells"], 1e-3,
-             now["tangled_cells"] <= 1e-3 * now["cells"])]
+    rows = [
+        (
+            "FEM folded cells / cells",
+            now["tangled_cells"] / now["cells"],
+            1e-3,
+            now["tangled_cells"] <= 1e-3 * now["cells"],
+        )
+    ]
     for lateral in ("symmetry", "noslip"):
         a, b = now[lateral], ref[lateral]
         rows.append(("FEM dofs, " + lateral, a["dofs"], b["dofs"], a["dofs"] == b["dofs"]))
         rows.append(("FEM kappa, " + lateral, a["kappa"], b["kappa"], abs(a["kappa"] / b["kappa"] - 1) < 1e-6))
-        rows.append(("FEM mean sphere force, " + lateral, a["sphere_force_y"], b["sphere_force_y"],
-                     abs(a["sphere_force_y"] / b["sphere_force_y"] - 1) < 1e-6))
+        rows.append(
+            (
+                "FEM mean sphere force, " + lateral,
+                a["sphere_force_y"],
+                b["sphere_force_y"],
+                abs(a["sphere_force_y"] / b["sphere_force_y"] - 1) < 1e-6,
+            )
+        )
         rows.append(("FEM |Q_in - Q_out| / Q_in, " + lateral, a["flux_balance"], 1e-4, a["flux_balance"] < 1e-4))
-    rows.append(("FEM kappa by MINRES / by LDL^T - 1, symmetry", now["kappa_minres"] / now["symmetry"]["kappa"] - 1,
-                 1e-8, abs(now["kappa_minres"] / now["symmetry"]["kappa"] - 1) < 1e-8))
+    rows.append(
+        (
+            "FEM kappa by MINRES / by LDL^T - 1, symmetry",
+            now["kappa_minres"] / now["symmetry"]["kappa"] - 1,
+            1e-8,
+            abs(now["kappa_minres"] / now["symmetry"]["kappa"] - 1) < 1e-8,
+        )
+    )
     for v, k in now["pfv"].items():
         rows.append(("PFV kappa, " + v, k, ref["pfv"][v], abs(k / ref["pfv"][v] - 1) < 1e-9))
     return rows
@@ -166,16 +213,29 @@ def main():
     ap.add_argument("--levels", default="0.048,0.034,0.024")
     ap.add_argument("--out", default=os.path.join(HERE, "results", "stokes_results.json"))
     ap.add_argument("--no-yade", action="store_true")
-    ap.add_argument("--solver", choices=("direct", "minres"), default="direct",
-                    help="MUMPS' LDL^T, or MINRES with a block AMG preconditioner (memory O(DOFs); solve.py)")
+    ap.add_argument(
+        "--solver",
+        choices=("direct", "minres"),
+        default="direct",
+        help="MUMPS' LDL^T, or MINRES with a block AMG preconditioner (memory O(DOFs); solve.py)",
+    )
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--write-reference", action="store_true")
-    ap.add_argument("--models-only", action="store_true",
-                    help="PFV and YADE only, no FEM (for the touching spheres, cases <name>@0)")
-    ap.add_argument("--yade-only", action="store_true",
-                    help="rerun YADE's engine only, into the cases already in --out (--cases=all: every one)")
-    ap.add_argument("--pfv-only", action="store_true",
-                    help="rerun PFV only, into the cases already in --out (--cases=all: every one)")
+    ap.add_argument(
+        "--models-only",
+        action="store_true",
+        help="PFV and YADE only, no FEM (for the touching spheres, cases <name>@0)",
+    )
+    ap.add_argument(
+        "--yade-only",
+        action="store_true",
+        help="rerun YADE's engine only, into the cases already in --out (--cases=all: every one)",
+    )
+    ap.add_argument(
+        "--pfv-only",
+        action="store_true",
+        help="rerun PFV only, into the cases already in --out (--cases=all: every one)",
+    )
     args = ap.parse_args()
     if args.quick:
         now = quick_numbers()

@@ -32,8 +32,18 @@ LATERAL = (1, 2, 5, 6)  # xmin, xmax, zmin, zmax: the flow is along y
 INLET, OUTLET = 3, 4
 
 
-def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_tolerance=1e-10, symmetric=True,
-          method="direct", rtol=1e-10):
+def solve(
+    mesh,
+    facets,
+    n_spheres,
+    lateral="symmetry",
+    dp=1.0,
+    mu=1.0,
+    blr_tolerance=1e-10,
+    symmetric=True,
+    method="direct",
+    rtol=1e-10,
+):
     start = time.perf_counter()
     cell = mesh.ufl_cell()
     element = ufl.MixedElement([ufl.VectorElement("Lagrange", cell, 2), ufl.FiniteElement("Lagrange", cell, 1)])
@@ -70,8 +80,9 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_toler
     solved = time.perf_counter()
     iterations = ksp.getIterationNumber()
     if method == "minres" and ksp.getConvergedReason() <= 0:
-        raise RuntimeError("MINRES did not converge (reason %d after %d iterations)"
-                           % (ksp.getConvergedReason(), iterations))
+        raise RuntimeError(
+            "MINRES did not converge (reason %d after %d iterations)" % (ksp.getConvergedReason(), iterations)
+        )
     ksp.getPC().reset()  # frees MUMPS' factor (or the AMG hierarchy) before the forces' forms are assembled
     uh, ph = w.split()
 
@@ -89,7 +100,9 @@ def solve(mesh, facets, n_spheres, lateral="symmetry", dp=1.0, mu=1.0, blr_toler
         obj.destroy()
     return {
         "lateral": lateral,
-        "flux_in": q_in, "flux_out": q_out, "flux_mean": flux_mean,
+        "flux_in": q_in,
+        "flux_out": q_out,
+        "flux_mean": flux_mean,
         "kappa": mu * flux / dp,  # l0 = 1, S = 1
         "dofs": W.dofmap.index_map.size_global * W.dofmap.index_map_bs,
         "velocity_dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
@@ -134,14 +147,18 @@ def solid_forces(mesh, facets, n_spheres, uh, ph, mu):
     e = fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
 
     def part_forms(measure):
-        return (fem.form(ph * ufl.dot(n, e) * measure(1)),
-                fem.form(-2 * mu * ufl.dot(ufl.dot(ufl.sym(ufl.grad(uh)), n), e) * measure(1)))
+        return (
+            fem.form(ph * ufl.dot(n, e) * measure(1)),
+            fem.form(-2 * mu * ufl.dot(ufl.dot(ufl.sym(ufl.grad(uh)), n), e) * measure(1)),
+        )
 
     forces = {}
-    for marker, name in [(SPHERE_TAG + k, "sphere%d" % k) for k in range(n_spheres)] + \
-            [(m, FACES[m - 1]) for m in LATERAL]:
-        tags = meshtags(mesh, fdim, np.sort(facets.find(marker)).astype(np.int32),
-                        np.ones(len(facets.find(marker)), dtype=np.int32))
+    for marker, name in [(SPHERE_TAG + k, "sphere%d" % k) for k in range(n_spheres)] + [
+        (m, FACES[m - 1]) for m in LATERAL
+    ]:
+        tags = meshtags(
+            mesh, fdim, np.sort(facets.find(marker)).astype(np.int32), np.ones(len(facets.find(marker)), dtype=np.int32)
+        )
         forms = part_forms(ufl.Measure("ds", domain=mesh, subdomain_data=tags))
         parts = {"pressure": [], "viscous": []}
         for i in range(3):
@@ -197,11 +214,17 @@ def minres_solver(W, A, bcs, mu, u, v, p, q, rtol):
     pc.setType("fieldsplit")
     pc.setFieldSplitIS(("u", is_u), ("p", is_p))
     pc.setFieldSplitType(PETSc.PC.CompositeType.ADDITIVE)
-    settings = {"fieldsplit_u_ksp_type": "preonly", "fieldsplit_u_pc_type": "hypre",
-                "fieldsplit_u_pc_hypre_type": "boomeramg", "fieldsplit_u_pc_hypre_boomeramg_strong_threshold": 0.5,
-                "fieldsplit_u_pc_hypre_boomeramg_coarsen_type": "HMIS",
-                "fieldsplit_u_pc_hypre_boomeramg_interp_type": "ext+i", "fieldsplit_u_pc_hypre_boomeramg_P_max": 4,
-                "fieldsplit_p_ksp_type": "preonly", "fieldsplit_p_pc_type": "jacobi"}
+    settings = {
+        "fieldsplit_u_ksp_type": "preonly",
+        "fieldsplit_u_pc_type": "hypre",
+        "fieldsplit_u_pc_hypre_type": "boomeramg",
+        "fieldsplit_u_pc_hypre_boomeramg_strong_threshold": 0.5,
+        "fieldsplit_u_pc_hypre_boomeramg_coarsen_type": "HMIS",
+        "fieldsplit_u_pc_hypre_boomeramg_interp_type": "ext+i",
+        "fieldsplit_u_pc_hypre_boomeramg_P_max": 4,
+        "fieldsplit_p_ksp_type": "preonly",
+        "fieldsplit_p_pc_type": "jacobi",
+    }
     opts = PETSc.Options()
     for key, value in settings.items():
         opts[prefix + key] = value

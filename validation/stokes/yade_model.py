@@ -12,8 +12,15 @@ import math
 import sys
 
 from yade import O, utils
-from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, FlowEngine, ForceResetter, InsertionSortCollider,
-                          InteractionLoop, NewtonIntegrator)
+from yade.wrapper import (
+    Bo1_Box_Aabb,
+    Bo1_Sphere_Aabb,
+    FlowEngine,
+    ForceResetter,
+    InsertionSortCollider,
+    InteractionLoop,
+    NewtonIntegrator,
+)
 
 FACES = ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax")
 
@@ -29,16 +36,25 @@ def run(packing, slip):
     flow.bndCondValue = [0, 0, 1.0, 0, 0, 0]
     flow.viscosity = 1.0
     flow.slipBoundary = slip
-    O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-                 InteractionLoop([], [], []), flow, NewtonIntegrator()]
+    O.engines = [
+        ForceResetter(),
+        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
+        InteractionLoop([], [], []),
+        flow,
+        NewtonIntegrator(),
+    ]
     O.dt = 1e-6
     O.step()
     q = float(flow.getBoundaryFlux(walls[3]))
     forces = {"sphere%d" % k: list(flow.fluidForce(b)) for k, b in enumerate(spheres)}
     forces.update({name: list(flow.fluidForce(b)) for name, b in zip(FACES, walls)})
     clean = {k: [x if math.isfinite(x) else None for x in v] for k, v in forces.items()}
-    return {"variant": "slip" if slip else "noslip", "kappa": q if math.isfinite(q) else None,
-            "cells": int(flow.nCells()), "forces": clean}
+    return {
+        "variant": "slip" if slip else "noslip",
+        "kappa": q if math.isfinite(q) else None,
+        "cells": int(flow.nCells()),
+        "forces": clean,
+    }
 
 
 def main(argv):

@@ -16,15 +16,26 @@ def sh(cmd):
 
 def machine_description():
     import yade
+
     d = {}
     lscpu = sh('lscpu')
-    for key in ('Model name', 'CPU(s)', 'Thread(s) per core', 'Core(s) per socket', 'Socket(s)', 'Hypervisor vendor',
-                'L2 cache', 'L3 cache', 'CPU max MHz', 'BogoMIPS'):
+    for key in (
+        'Model name',
+        'CPU(s)',
+        'Thread(s) per core',
+        'Core(s) per socket',
+        'Socket(s)',
+        'Hypervisor vendor',
+        'L2 cache',
+        'L3 cache',
+        'CPU max MHz',
+        'BogoMIPS',
+    ):
         for line in lscpu.splitlines():
             if line.startswith(key + ':'):
                 d[key] = line.split(':', 1)[1].strip()
     mem = sh("grep MemTotal /proc/meminfo").split()
-    d['RAM'] = '%.1f GiB' % (int(mem[1]) / 2 ** 20) if len(mem) > 1 else '?'
+    d['RAM'] = '%.1f GiB' % (int(mem[1]) / 2**20) if len(mem) > 1 else '?'
     d['kernel'] = platform.release()
     d['os'] = sh('. /etc/os-release && echo "$PRETTY_NAME"')
     d['compiler'] = sh('c++ --version | head -1')
@@ -36,21 +47,28 @@ def machine_description():
                 if line.startswith(key):
                     flags.append('%s=%s' % (key.split(':')[0], line.split('=', 1)[1].strip()))
     d['pfv build'] = ', '.join(flags)
-    pkgs = sh("dpkg-query -W -f='${Package} ${Version}\\n' yade libcgal-dev libsuitesparse-dev libmetis-dev "
-              "libeigen3-dev pybind11-dev python3-numpy libboost-dev 2>/dev/null")
+    pkgs = sh(
+        "dpkg-query -W -f='${Package} ${Version}\\n' yade libcgal-dev libsuitesparse-dev libmetis-dev "
+        "libeigen3-dev pybind11-dev python3-numpy libboost-dev 2>/dev/null"
+    )
     d['packages'] = '; '.join(pkgs.splitlines())
     d['python'] = platform.python_version()
     d['yade'] = getattr(yade.config, 'version', '?') if hasattr(yade, 'config') else '?'
     try:
         import pfv
+
         d['pfv module'] = os.path.dirname(pfv.__file__)
     except Exception as e:
         d['pfv module'] = 'IMPORT FAILED: %s' % e
-    d['git'] = (sh('git -C %s rev-parse --short HEAD' % REPO) +
-                (' (working tree modified in lib/ pkg/)'
-                 if sh('git -C %s status --porcelain lib pkg CMakeLists.txt' % REPO) else ''))
-    d['BLAS'] = (os.path.realpath('/usr/lib/x86_64-linux-gnu/libblas.so.3') +
-                 ' (children run with OPENBLAS_NUM_THREADS = OMP_NUM_THREADS = yade -jN)')
+    d['git'] = sh('git -C %s rev-parse --short HEAD' % REPO) + (
+        ' (working tree modified in lib/ pkg/)'
+        if sh('git -C %s status --porcelain lib pkg CMakeLists.txt' % REPO)
+        else ''
+    )
+    d['BLAS'] = (
+        os.path.realpath('/usr/lib/x86_64-linux-gnu/libblas.so.3')
+        + ' (children run with OPENBLAS_NUM_THREADS = OMP_NUM_THREADS = yade -jN)'
+    )
     d['load average at start'] = ' '.join('%.2f' % x for x in os.getloadavg())
     return d
 

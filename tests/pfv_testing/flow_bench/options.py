@@ -5,9 +5,15 @@ from pfv_testing.paths import REPO
 
 
 # Flags without a value: the option each sets and to what (--quick and --startup are read first).
-FLAGS = {'--quick': ('quick', True), '--startup': ('startup', True), '--report-only': ('report_only', True),
-         '--no-memory': ('memory', False), '--no-oedometer': ('oedometer', False),
-         '--no-multithread': ('multithread', False), '--no-double': ('double', False)}
+FLAGS = {
+    '--quick': ('quick', True),
+    '--startup': ('startup', True),
+    '--report-only': ('report_only', True),
+    '--no-memory': ('memory', False),
+    '--no-oedometer': ('oedometer', False),
+    '--no-multithread': ('multithread', False),
+    '--no-double': ('double', False),
+}
 LISTS = ('sizes', 'threads', 'oedo_sizes')
 INTEGERS = ('rounds', 'oedo_steps', 'oedo_interval', 'steady', 'size', 'gen_threads')
 STRINGS = ('out', 'json', 'child', 'engine', 'child_json')

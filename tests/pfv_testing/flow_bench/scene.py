@@ -7,16 +7,16 @@ import math
 import os
 import time
 
-FORMAT_VERSION = 1          # of the packing files
+FORMAT_VERSION = 1  # of the packing files
 SEED = 1
-DP = 100.0                  # permeameter pressure drop [Pa] (1 % of the 10 kPa confinement)
-VISCOSITY = 1e-3            # permeameter viscosity [Pa s]
-STRESS = -1.0e4             # confining stress of the packings [Pa]
+DP = 100.0  # permeameter pressure drop [Pa] (1 % of the 10 kPa confinement)
+VISCOSITY = 1e-3  # permeameter viscosity [Pa s]
+STRESS = -1.0e4  # confining stress of the packings [Pa]
 YOUNG = 1.0e6
 OEDO_VISCOSITY = 10.0
 OEDO_LOAD = -1.1e4
 OEDO_DT = 1e-4
-AXIS = 1                    # flow along y
+AXIS = 1  # flow along y
 
 
 def log(*args):
@@ -42,7 +42,7 @@ def read_packing(n):
         for line in f:
             if line.startswith('#'):
                 if line.startswith('# meta '):
-                    meta = json.loads(line[len('# meta '):])
+                    meta = json.loads(line[len('# meta ') :])
                 continue
             if line.strip():
                 spheres.append(tuple(float(v) for v in line.split()))
@@ -51,6 +51,7 @@ def read_packing(n):
 
 def packing_digest(spheres):
     import hashlib
+
     h = hashlib.sha256()
     for s in spheres:
         h.update((' '.join(repr(v) for v in s) + '\n').encode())
@@ -60,10 +61,22 @@ def packing_digest(spheres):
 def generate_packing(n):
     """Radius-growth compaction (runs in a child yade process); writes the cache file."""
     from yade import O, pack, utils
-    from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, GlobalStiffnessTimeStepper,
-                              Ig2_Box_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                              Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator,
-                              TriaxialStressController)
+    from yade.wrapper import (
+        Bo1_Box_Aabb,
+        Bo1_Sphere_Aabb,
+        ForceResetter,
+        FrictMat,
+        GlobalStiffnessTimeStepper,
+        Ig2_Box_Sphere_ScGeom,
+        Ig2_Sphere_Sphere_ScGeom,
+        InsertionSortCollider,
+        InteractionLoop,
+        Ip2_FrictMat_FrictMat_FrictPhys,
+        Law2_ScGeom_FrictPhys_CundallStrack,
+        NewtonIntegrator,
+        TriaxialStressController,
+    )
+
     t0 = time.time()
     L = box_side(n)
     O.reset()
@@ -73,14 +86,23 @@ def generate_packing(n):
     sp = pack.SpherePack()
     sp.makeCloud((0, 0, 0), (L, L, L), -1, 0.3333, n, False, 0.7, seed=SEED)
     sp.toSimulation(material='spheres')
-    triax = TriaxialStressController(maxMultiplier=1. + 2e4 / YOUNG, finalMaxMultiplier=1. + 2e3 / YOUNG, thickness=0,
-                                     stressMask=7, max_vel=0.005, internalCompaction=True)
+    triax = TriaxialStressController(
+        maxMultiplier=1.0 + 2e4 / YOUNG,
+        finalMaxMultiplier=1.0 + 2e3 / YOUNG,
+        thickness=0,
+        stressMask=7,
+        max_vel=0.005,
+        internalCompaction=True,
+    )
     triax.goal1 = triax.goal2 = triax.goal3 = STRESS
     O.engines = [
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-        InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                        [Law2_ScGeom_FrictPhys_CundallStrack()]),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys()],
+            [Law2_ScGeom_FrictPhys_CundallStrack()],
+        ),
         GlobalStiffnessTimeStepper(active=1, timeStepUpdateInterval=100, timestepSafetyCoefficient=0.8),
         triax,
         NewtonIntegrator(damping=0.5),
@@ -99,11 +121,23 @@ def generate_packing(n):
     spheres = [(b.state.pos[0], b.state.pos[1], b.state.pos[2], b.shape.radius) for b in O.bodies if b.id >= 6]
     vs = sum(4.0 / 3.0 * math.pi * s[3] ** 3 for s in spheres)
     radii = [s[3] for s in spheres]
-    meta = dict(n=n, seed=SEED, box=L, porosity=1 - vs / L ** 3, iterations=O.iter, seconds=time.time() - t0,
-                unbalanced=unb, mean_stress=triax.meanStress, r_min=min(radii), r_max=max(radii),
-                r_mean=sum(radii) / len(radii), threads=O.numThreads, date=datetime.date.today().isoformat(),
-                method='makeCloud(porosity 0.7, rRelFuzz 1/3, seed %d) + radius growth (TriaxialStressController '
-                       'internalCompaction, E=1e6, 3 deg, damping 0.5) to 10 kPa, unbalanced force < 0.01' % SEED)
+    meta = dict(
+        n=n,
+        seed=SEED,
+        box=L,
+        porosity=1 - vs / L**3,
+        iterations=O.iter,
+        seconds=time.time() - t0,
+        unbalanced=unb,
+        mean_stress=triax.meanStress,
+        r_min=min(radii),
+        r_max=max(radii),
+        r_mean=sum(radii) / len(radii),
+        threads=O.numThreads,
+        date=datetime.date.today().isoformat(),
+        method='makeCloud(porosity 0.7, rRelFuzz 1/3, seed %d) + radius growth (TriaxialStressController '
+        'internalCompaction, E=1e6, 3 deg, damping 0.5) to 10 kPa, unbalanced force < 0.01' % SEED,
+    )
     O.reset()
     os.makedirs(cache_dir(), exist_ok=True)
     tmp = packing_path(n) + '.tmp%d' % os.getpid()
@@ -113,23 +147,37 @@ def generate_packing(n):
         for s in spheres:
             f.write(' '.join(repr(float(v)) for v in s) + '\n')
     os.replace(tmp, packing_path(n))
-    log('packing n=%d: %d iterations, %.1f s, porosity %.4f, unbalanced force %.3g'
-        % (n, meta['iterations'], meta['seconds'], meta['porosity'], unb))
+    log(
+        'packing n=%d: %d iterations, %.1f s, porosity %.4f, unbalanced force %.3g'
+        % (n, meta['iterations'], meta['seconds'], meta['porosity'], unb)
+    )
     return meta
 
 
 def build_scene(n, oedometer=False, settle=True):
     """Build the scene from the cached packing in a reset O. Returns info dict."""
     from yade import O, utils
-    from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,
-                              Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                              Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator,
-                              TriaxialStressController)
+    from yade.wrapper import (
+        Bo1_Box_Aabb,
+        Bo1_Sphere_Aabb,
+        ForceResetter,
+        FrictMat,
+        Ig2_Box_Sphere_ScGeom,
+        Ig2_Sphere_Sphere_ScGeom,
+        InsertionSortCollider,
+        InteractionLoop,
+        Ip2_FrictMat_FrictMat_FrictPhys,
+        Law2_ScGeom_FrictPhys_CundallStrack,
+        NewtonIntegrator,
+        TriaxialStressController,
+    )
+
     spheres, meta = read_packing(n)
     L = meta.get('box', box_side(n))
     O.reset()
-    O.materials.append(FrictMat(young=YOUNG, poisson=0.5, frictionAngle=math.radians(30), density=2600,
-                                label='spheres'))
+    O.materials.append(
+        FrictMat(young=YOUNG, poisson=0.5, frictionAngle=math.radians(30), density=2600, label='spheres')
+    )
     O.materials.append(FrictMat(young=YOUNG, poisson=0.5, frictionAngle=0, density=0, label='walls'))
     walls = O.bodies.append(utils.aabbWalls([(0, 0, 0), (L, L, L)], thickness=0, material='walls'))
     assert walls == list(range(6)), walls
@@ -138,12 +186,16 @@ def build_scene(n, oedometer=False, settle=True):
     engines = [
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-        InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                        [Law2_ScGeom_FrictPhys_CundallStrack()]),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys()],
+            [Law2_ScGeom_FrictPhys_CundallStrack()],
+        ),
     ]
     if oedometer:
-        triax = TriaxialStressController(thickness=0, stressMask=2, max_vel=0.005, internalCompaction=False,
-                                         label='triax')
+        triax = TriaxialStressController(
+            thickness=0, stressMask=2, max_vel=0.005, internalCompaction=False, label='triax'
+        )
         triax.goal1 = triax.goal3 = 0
         triax.goal2 = STRESS
         triax.wall_bottom_activated = False
@@ -167,8 +219,16 @@ def build_scene(n, oedometer=False, settle=True):
         if not settle or unb < 0.01 or steps >= 1000:
             break
     newton.damping = 0.0 if oedometer else 0.2
-    return dict(n=n, box=L, digest=packing_digest(spheres), meta=meta, dt=O.dt, bodies=len(O.bodies),
-                settle_steps=steps, unbalanced=unb)
+    return dict(
+        n=n,
+        box=L,
+        digest=packing_digest(spheres),
+        meta=meta,
+        dt=O.dt,
+        bodies=len(O.bodies),
+        settle_steps=steps,
+        unbalanced=unb,
+    )
 
 
 def make_engine(kind, oedometer=False, oedo_interval=200):
@@ -189,7 +249,7 @@ def make_engine(kind, oedometer=False, oedo_interval=200):
         isP[2 * AXIS] = isP[2 * AXIS + 1] = True
         val[2 * AXIS] = DP
         flow.viscosity = VISCOSITY
-        flow.meshUpdateInterval = 10 ** 9
+        flow.meshUpdateInterval = 10**9
         flow.defTolerance = 0.0
     flow.wallIds = [0, 1, 2, 3, 4, 5]
     flow.bndCondIsPressure = isP
@@ -211,6 +271,7 @@ def make_engine(kind, oedometer=False, oedo_interval=200):
 def insert_engine(flow):
     from yade import O
     from yade.wrapper import NewtonIntegrator
+
     engines = list(O.engines)
     i = [k for k, e in enumerate(engines) if isinstance(e, NewtonIntegrator)][0]
     engines.insert(i, flow)

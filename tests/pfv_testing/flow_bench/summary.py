@@ -16,11 +16,16 @@ def _engine_columns(trials):
         coupled.append(median(x['steady']['wall']))
         remesh.append(sum(x['remesh']['exec']) - (WINDOW - 1) * fs)
         first.append(sum(x['first']['exec']) - (WINDOW - 1) * fs)
-    return dict(flow=median(flow_step), remesh=median(remesh), first=median(first),
-                cpu_share=median([x['steady'].get('cpu_share') for x in trials]),
-                coupled=median(coupled), flow_range=(min(flow_step), max(flow_step)),
-                remesh_range=(min(remesh), max(remesh)),
-                cells=trials[0]['n_cells'] if trials else None)
+    return dict(
+        flow=median(flow_step),
+        remesh=median(remesh),
+        first=median(first),
+        cpu_share=median([x['steady'].get('cpu_share') for x in trials]),
+        coupled=median(coupled),
+        flow_range=(min(flow_step), max(flow_step)),
+        remesh_range=(min(remesh), max(remesh)),
+        cells=trials[0]['n_cells'] if trials else None,
+    )
 
 
 def _agreement(row, tr):
@@ -29,11 +34,16 @@ def _agreement(row, tr):
         py, pp = tr['yade'][0]['probes'], tr['pfv'][0]['probes']
         diffs = [abs(a - b) / DP for a, b in zip(py, pp)]
         fy, fp = tr['yade'][0]['flux'], tr['pfv'][0]['flux']
-        row['agreement'] = dict(max_dp=max(diffs), mean_dp=sum(diffs) / len(diffs),
-                                flux_in_rel=abs(fp[0] - fy[0]) / abs(fy[0]) if fy[0] else float('nan'),
-                                flux_out_rel=abs(fp[1] - fy[1]) / abs(fy[1]) if fy[1] else float('nan'),
-                                flux_yade=fy, flux_pfv=fp,
-                                probe_yade=py[13], probe_pfv=pp[13])
+        row['agreement'] = dict(
+            max_dp=max(diffs),
+            mean_dp=sum(diffs) / len(diffs),
+            flux_in_rel=abs(fp[0] - fy[0]) / abs(fy[0]) if fy[0] else float('nan'),
+            flux_out_rel=abs(fp[1] - fy[1]) / abs(fy[1]) if fy[1] else float('nan'),
+            flux_yade=fy,
+            flux_pfv=fp,
+            probe_yade=py[13],
+            probe_pfv=pp[13],
+        )
     if tr['pfv'] and tr.get('pfv-double'):
         # the default (32-bit factor, refined) against the direct double solve, same steps from the same state
         pp, pd = tr['pfv'][0]['probes'], tr['pfv-double'][0]['probes']
@@ -53,8 +63,7 @@ def _pfv_remesh_stages(x):
     d = {s: rt[s] for s in rem_stages}
     d.update({'first ' + s: stt[s] for s in STEP_STAGES})
     cpp = sum(d.values())
-    d['python + exchange'] = (x['remesh']['exec'][k] -
-                              (x['remesh']['core_step'][k] if x['core_timer'] else cpp))
+    d['python + exchange'] = x['remesh']['exec'][k] - (x['remesh']['core_step'][k] if x['core_timer'] else cpp)
     if x['core_timer']:
         d['C++ untimed'] = x['remesh']['core_step'][k] - cpp
     d['total (engine exec)'] = x['remesh']['exec'][k]
@@ -131,10 +140,14 @@ def _oedometer_row(ns, od):
     r = dict(n=int(ns), steps=od['steps'], interval=od['interval'], dry=dry)
     for kind in [k for k in ('yade', 'pfv', 'yade-mt', 'pfv-mt') if tr.get(k)]:
         c = median([x['seconds'] / x['steps'] for x in tr[kind]])
-        r[kind] = dict(coupled=c, ratio=c / dry if dry else float('nan'),
-                       exec=median([x['exec'] / x['steps'] for x in tr[kind]]),
-                       p_mid=tr[kind][0].get('p_mid'), remeshes=tr[kind][0].get('remeshes'),
-                       settlement=tr[kind][0].get('settlement'))
+        r[kind] = dict(
+            coupled=c,
+            ratio=c / dry if dry else float('nan'),
+            exec=median([x['exec'] / x['steps'] for x in tr[kind]]),
+            p_mid=tr[kind][0].get('p_mid'),
+            remeshes=tr[kind][0].get('remeshes'),
+            settlement=tr[kind][0].get('settlement'),
+        )
     r['dry_settlement'] = tr['dry'][0]['settlement'] if tr['dry'] else None
     return r
 
@@ -179,25 +192,42 @@ def startup_summary(data):
                 cold = [g for g in x['guard'] if g['remesh_count'] == 1]
                 warm = [g for g in x['guard'] if g['remesh_count'] == 2]
                 for key, a, b in (
-                        ('ordering', tf['analysis'], tr['analysis']),
-                        ('factorization', tf['factorization'], tr['factorization']),
-                        ('triangulation + geometry', tf['triangulation'] + tf['geometry'],
-                         tr['triangulation'] + tr['geometry']),
-                        ('time-step guard', sum(g['seconds'] for g in cold), sum(g['seconds'] for g in warm)),
-                        ('python + exchange', x['first']['exec'][0] - x['first']['core_step'][0],
-                         x['remesh']['exec'][0] - x['remesh']['core_step'][0])):
+                    ('ordering', tf['analysis'], tr['analysis']),
+                    ('factorization', tf['factorization'], tr['factorization']),
+                    (
+                        'triangulation + geometry',
+                        tf['triangulation'] + tf['geometry'],
+                        tr['triangulation'] + tr['geometry'],
+                    ),
+                    ('time-step guard', sum(g['seconds'] for g in cold), sum(g['seconds'] for g in warm)),
+                    (
+                        'python + exchange',
+                        x['first']['exec'][0] - x['first']['core_step'][0],
+                        x['remesh']['exec'][0] - x['remesh']['core_step'][0],
+                    ),
+                ):
                     parts.setdefault(key, []).append((a, b))
-                parts.setdefault('applications', []).append((sum(g['iterations'] for g in cold),
-                                                             sum(g['iterations'] for g in warm)))
-                parts.setdefault('methods', []).append(('+'.join(g.get('method', '?') for g in cold),
-                                                        '+'.join(g.get('method', '?') for g in warm)))
+                parts.setdefault('applications', []).append(
+                    (sum(g['iterations'] for g in cold), sum(g['iterations'] for g in warm))
+                )
+                parts.setdefault('methods', []).append(
+                    ('+'.join(g.get('method', '?') for g in cold), '+'.join(g.get('method', '?') for g in warm))
+                )
                 parts.setdefault('factor nonzeros', []).append((x['factor_nonzeros'], x['factor_nonzeros']))
-            pair_medians = {k: v[0] if k == 'methods' else (median([a for a, _ in v]), median([b for _, b in v]))
-                            for k, v in parts.items()}
-            row[kind] = dict(first=median(first), remesh=median(remesh), ratio=median(ratio), first_per_round=first,
-                             first_range=(min(first), max(first)), ratio_range=(min(ratio), max(ratio)),
-                             cpu_share=median(cpu),
-                             parts=pair_medians)
+            pair_medians = {
+                k: v[0] if k == 'methods' else (median([a for a, _ in v]), median([b for _, b in v]))
+                for k, v in parts.items()
+            }
+            row[kind] = dict(
+                first=median(first),
+                remesh=median(remesh),
+                ratio=median(ratio),
+                first_per_round=first,
+                first_range=(min(first), max(first)),
+                ratio_range=(min(ratio), max(ratio)),
+                cpu_share=median(cpu),
+                parts=pair_medians,
+            )
         row['pfv_over_yade_first'] = row['pfv']['first'] / row['yade']['first']
         # Per round: the two engines' trials of one round ran next to each other, at the same machine speed.
         per_round = [p / y for y, p in zip(row['yade']['first_per_round'], row['pfv']['first_per_round'])]

@@ -4,12 +4,20 @@ import gc
 import os
 import time
 
-from pfv_testing.flow_bench.scene import (AXIS, OEDO_LOAD, build_scene, core_timer, insert_engine, log, make_engine,
-                                          probe_points)
+from pfv_testing.flow_bench.scene import (
+    AXIS,
+    OEDO_LOAD,
+    build_scene,
+    core_timer,
+    insert_engine,
+    log,
+    make_engine,
+    probe_points,
+)
 from pfv_testing.memory import reset_peak, rss_kb
 from pfv_testing.timing import median
 
-WINDOW = 3                  # steps timed after a (forced) remesh
+WINDOW = 3  # steps timed after a (forced) remesh
 
 
 def _yade_td(flow):
@@ -28,12 +36,14 @@ def _dem_exec(flow):
     """Seconds of execTime of every engine but the flow engine so far (O.timingEnabled): the DEM
     part of a step, to compare the DEM of the coupled steps with the dry steps."""
     from yade import O
+
     return sum(e.execTime for e in O.engines if e is not flow) * 1e-9
 
 
 def _dry_trial(res, steady):
     """The dry trial (no flow engine): wall and DEM time of the steady steps."""
     from yade import O
+
     for _ in range(WINDOW):
         O.step()
     wall, dem = [], []
@@ -54,6 +64,7 @@ def _step(flow, kind, proxy, record):
     """One O.step() with the engine, its wall time, engine time and DEM time added to `record` (and for pfv the
     core's stage times, remesh count and core step)."""
     from yade import O
+
     e0 = flow.execTime
     d0 = _dem_exec(flow)
     t0 = time.perf_counter()
@@ -104,6 +115,7 @@ def _engine_state(res, flow, kind, proxy, info):
     """What the engine shows at the end of a trial: pressures at the probes, fluxes, and for pfv its factor and
     time-step guard."""
     from yade import O
+
     L = info['box']
     res['vmax'] = max(b.state.vel.norm() for b in O.bodies)
     res['probes'] = [flow.getPorePressure(p) for p in probe_points(L)]
@@ -119,6 +131,7 @@ def run_trial(kind, info, steady, warnings_seen):
     """One trial on the saved permeameter scene. kind in yade, pfv, dry."""
     import warnings
     from yade import O
+
     O.loadTmp('bench')
     O.timingEnabled = True
     gc.collect()
@@ -156,6 +169,7 @@ def exchange_reference(info):
     import numpy as np
     import yade
     from yade import O
+
     O.loadTmp('bench')
     cad = yade._utils.coordsAndDisplacements
     ids = list(range(6, len(O.bodies)))
@@ -176,6 +190,7 @@ def exchange_reference(info):
 
 def oedometer_trial(kind, n, steps, interval):
     from yade import O
+
     O.loadTmp('oedo')
     triax = [e for e in O.engines if type(e).__name__ == 'TriaxialStressController'][0]
     triax.goal2 = OEDO_LOAD
@@ -211,15 +226,18 @@ def oedometer_trial(kind, n, steps, interval):
 
 def timing_child(opts):
     from yade import O
+
     out = dict(threads=O.numThreads, sizes={}, oedometer={}, warnings=[], load_start=os.getloadavg())
     rounds = opts['rounds']
     for n in opts['sizes']:
         info = build_scene(n)
         O.saveTmp('bench')
         steady = opts['steady'] if n <= 20000 else max(5, opts['steady'] // 2)
-        log('timing n=%d (%d bodies, dt %.3g, settled in %d steps to unbalanced force %.3g) threads=%d, %d rounds, '
-            '%d steady steps' % (n, info['bodies'], info['dt'], info['settle_steps'], info['unbalanced'], O.numThreads,
-                                 rounds, steady))
+        log(
+            'timing n=%d (%d bodies, dt %.3g, settled in %d steps to unbalanced force %.3g) threads=%d, %d rounds, '
+            '%d steady steps'
+            % (n, info['bodies'], info['dt'], info['settle_steps'], info['unbalanced'], O.numThreads, rounds, steady)
+        )
         order = ['yade', 'pfv', 'dry'] + (['pfv-double'] if opts['double'] else [])
         trials = {kind: [] for kind in order}
         for r in range(rounds):
@@ -254,15 +272,18 @@ def timing_child(opts):
 def startup_child(opts):
     """YADE and PFV trials only (run_trial), the order swapped every round."""
     from yade import O
+
     out = dict(threads=O.numThreads, sizes={}, warnings=[], load_start=os.getloadavg())
     for n in opts['sizes']:
         info = build_scene(n)
         O.saveTmp('bench')
-        log('startup n=%d (%d bodies, settled in %d steps) threads=%d, %d rounds, %d steady steps'
-            % (n, info['bodies'], info['settle_steps'], O.numThreads, opts['rounds'], opts['steady']))
+        log(
+            'startup n=%d (%d bodies, settled in %d steps) threads=%d, %d rounds, %d steady steps'
+            % (n, info['bodies'], info['settle_steps'], O.numThreads, opts['rounds'], opts['steady'])
+        )
         trials = dict(yade=[], pfv=[])
         for r in range(opts['rounds']):
-            for kind in (('yade', 'pfv') if r % 2 == 0 else ('pfv', 'yade')):
+            for kind in ('yade', 'pfv') if r % 2 == 0 else ('pfv', 'yade'):
                 t0 = time.time()
                 trials[kind].append(run_trial(kind, info, opts['steady'], out['warnings']))
                 log('  n=%d round %d %-4s done in %.1f s' % (n, r + 1, kind, time.time() - t0))
@@ -275,6 +296,7 @@ def startup_child(opts):
 
 def memory_child(opts):
     from yade import O
+
     n, kind = opts['size'], opts['engine']
     build_scene(n, settle=False)
     gc.collect()
@@ -294,6 +316,15 @@ def memory_child(opts):
     peak_remesh, after = rss_kb('VmHWM'), rss_kb()
     if not exact:
         peak_remesh = max(peak_remesh, peak_first)
-    return dict(n=n, kind=kind, rss_before_kb=before, peak_kb=max(peak_first, peak_remesh), peak_first_kb=peak_first,
-                rss_mid_kb=mid, peak_remesh_kb=peak_remesh, rss_after_kb=after, peak_reset=exact,
-                threads=O.numThreads)
+    return dict(
+        n=n,
+        kind=kind,
+        rss_before_kb=before,
+        peak_kb=max(peak_first, peak_remesh),
+        peak_first_kb=peak_first,
+        rss_mid_kb=mid,
+        peak_remesh_kb=peak_remesh,
+        rss_after_kb=after,
+        peak_reset=exact,
+        threads=O.numThreads,
+    )

@@ -47,7 +47,7 @@ def _check_report(out, check):
     check(head is not None, 'timing table has YADE and PFV columns')
     rows = []
     if head is not None:
-        for line in lines[head + 2:]:
+        for line in lines[head + 2 :]:
             if not line.startswith('|'):
                 break
             rows.append(line)
@@ -73,8 +73,7 @@ def _check_timings(row, check):
         check(stage in br.get('steady', {}), 'PFV steady breakdown has %s' % stage)
     a = row.get('agreement', {})
     check(isinstance(a.get('max_dp'), float) and math.isfinite(a['max_dp']), 'pressure comparison computed')
-    print('  (info) probe pressures: max |dp|/dp = %s, Qin rel. diff = %s'
-          % (a.get('max_dp'), a.get('flux_in_rel')))
+    print('  (info) probe pressures: max |dp|/dp = %s, Qin rel. diff = %s' % (a.get('max_dp'), a.get('flux_in_rel')))
 
 
 def _check_json(js, check):
@@ -120,11 +119,13 @@ def main():
 def test_bench_quick():
     """pytest entry: runs this file under yade-double."""
     import pytest
+
     exe = shutil.which('yade-double')
     if exe is None:
         pytest.skip('yade-double not installed')
-    r = subprocess.run([exe, '-n', '-x', os.path.join(HERE, 'test_bench_quick.py')], capture_output=True, text=True,
-                       timeout=900)
+    r = subprocess.run(
+        [exe, '-n', '-x', os.path.join(HERE, 'test_bench_quick.py')], capture_output=True, text=True, timeout=900
+    )
     print(r.stdout[-6000:])
     assert r.returncode == 0, 'yade-double exited with %d\n%s\n%s' % (r.returncode, r.stdout[-4000:], r.stderr[-2000:])
 

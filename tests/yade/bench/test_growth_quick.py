@@ -34,8 +34,21 @@ def positive(x):
 
 with tempfile.TemporaryDirectory(prefix="pfv-growth-") as work:
     report, data, png = (os.path.join(work, name) for name in ("growth.md", "growth.json", "growth.png"))
-    run = subprocess.run(["yade-double", "-n", "-x", os.path.join(BENCH, "growth.py"), "--quick", f"--out={report}",
-                          f"--json={data}", f"--figure={png}"], capture_output=True, text=True, timeout=1200)
+    run = subprocess.run(
+        [
+            "yade-double",
+            "-n",
+            "-x",
+            os.path.join(BENCH, "growth.py"),
+            "--quick",
+            f"--out={report}",
+            f"--json={data}",
+            f"--figure={png}",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=1200,
+    )
     check("growth.py --quick exits with 0", run.returncode == 0, (run.stdout + run.stderr)[-800:])
     if run.returncode == 0:
         with open(data) as f:
@@ -54,12 +67,18 @@ with tempfile.TemporaryDirectory(prefix="pfv-growth-") as work:
         check("one row per size and engine", set(rows) == expected, str(sorted(rows)))
         for (n, kind), cells in sorted(rows.items()):
             numbers = [float(c) for c in (cells[2], cells[3], cells[5], cells[7])]  # first, remesh, dry, peak
-            check(f"N={n} {kind}: positive first step, remesh, dry step and peak RSS", all(map(positive, numbers)),
-                  str(cells))
+            check(
+                f"N={n} {kind}: positive first step, remesh, dry step and peak RSS",
+                all(map(positive, numbers)),
+                str(cells),
+            )
             ratio, spread = cells[6].split(" ", 1)
             low, high = (float(x) for x in spread.strip("()").split("\u2013"))
-            check(f"N={n} {kind}: coupled / dry, the median of the blocks, within their range",
-                  0 < low <= float(ratio) <= high, cells[6])
+            check(
+                f"N={n} {kind}: coupled / dry, the median of the blocks, within their range",
+                0 < low <= float(ratio) <= high,
+                cells[6],
+            )
             if kind == "pfv":
                 check(f"N={n} pfv: auto chose CHOLMOD", cells[8].startswith("cholesky"), cells[8])
             if kind == "pfv-multigrid":

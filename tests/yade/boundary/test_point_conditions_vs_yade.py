@@ -54,8 +54,10 @@ rows = [
     ("injection-point pressure rel. diff", abs(mine["p_injection"] - yade["p_injection"]) / scale, 0.05),
     ("drained flux rel. diff", abs(mine["q_top"] - yade["q_top"]) / abs(yade["q_top"]), 0.05),
 ]
-print(f"YADE: p_inj {yade['p_injection']:.6g}  q_top {yade['q_top']:.6g}   "
-      f"pfv: p_inj {mine['p_injection']:.6g}  q_top {mine['q_top']:.6g}")
+print(
+    f"YADE: p_inj {yade['p_injection']:.6g}  q_top {yade['q_top']:.6g}   "
+    f"pfv: p_inj {mine['p_injection']:.6g}  q_top {mine['q_top']:.6g}"
+)
 failed = 0
 for name, value, limit in rows:
     ok = value if isinstance(limit, bool) else value <= limit

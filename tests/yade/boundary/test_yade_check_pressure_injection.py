@@ -48,6 +48,7 @@ def main(argv):
     ns = vars(__main__)  # its PyRunner commands are evaluated in __main__
     ns.update(checksPath=os.path.dirname(SCRIPT), YadeCheckError=YadeCheckError, FlowEngine=pfv.FlowEngine)
     from yade import plot
+
     plot.plot = lambda *a, **k: None  # no GUI
     source = open(SCRIPT).read()
     if "FlowEngine(" not in source:
@@ -67,8 +68,9 @@ def main(argv):
     flow = engines[0]
     nvoids, bar, level = ns["nvoids"], ns["bar"], ns["initiallevel"]
     dry = [ii for ii in range(nvoids) if bar[ii] >= level]
-    print(f"script done in {time.time() - t0:.0f} s: O.iter {O.iter}, {nvoids} cells, {len(dry)} dry, "
-          f"O.dt {O.dt:.4g}")
+    print(
+        f"script done in {time.time() - t0:.0f} s: O.iter {O.iter}, {nvoids} cells, {len(dry)} dry, " f"O.dt {O.dt:.4g}"
+    )
     t0 = time.time()
     try:
         O.run(steps, True)
@@ -79,17 +81,25 @@ def main(argv):
     q_in = -ns["Qin"] - ns["deltabubble"]
     total = ns["total"]
     still_dry = sum(1 for ii in dry if flow.getCellPImposed(ii))
-    print(f"{steps} loop steps in {time.time() - t0:.0f} s: water in through ymin {q_in:.6g}, taken in by the "
-          f"dry cells {total:.6g}, difference {q_in - total:.3g}; {len(dry) - still_dry} of {len(dry)} dry cells "
-          f"filled and freed, {ns['bubble']} bubbles")
+    print(
+        f"{steps} loop steps in {time.time() - t0:.0f} s: water in through ymin {q_in:.6g}, taken in by the "
+        f"dry cells {total:.6g}, difference {q_in - total:.3g}; {len(dry) - still_dry} of {len(dry)} dry cells "
+        f"filled and freed, {ns['bubble']} bubbles"
+    )
     checks = [
-        ("inflow balances the water taken in by the dry cells (|difference| <= 1e-6)",
-         abs(q_in - total) <= VOLUME_TOLERANCE),
+        (
+            "inflow balances the water taken in by the dry cells (|difference| <= 1e-6)",
+            abs(q_in - total) <= VOLUME_TOLERANCE,
+        ),
         ("water came in through ymin", q_in > 0),
         ("the wall-force balance was checked (1.5 s reached)", steps < 1500 or ns["checkdifference"] == 1),
         ("dry cells filled and were freed", 0 < len(dry) - still_dry < len(dry)),
-        ("every freed cell had taken in its void volume",
-         all(-ns["totalflux"][ii] >= ns["initialvol"][ii] * (1 - 1e-12) for ii in dry if not flow.getCellPImposed(ii))),
+        (
+            "every freed cell had taken in its void volume",
+            all(
+                -ns["totalflux"][ii] >= ns["initialvol"][ii] * (1 - 1e-12) for ii in dry if not flow.getCellPImposed(ii)
+            ),
+        ),
     ]
     failed = [name for name, ok in checks if not ok]
     for name, ok in checks:

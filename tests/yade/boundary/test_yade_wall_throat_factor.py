@@ -33,6 +33,7 @@ def outflux(make_flow, slip=True, **extra):
 
 def main():
     from pfv import FlowEngine as PfvFlow
+
     rows = []
 
     def check(name, value, ok):

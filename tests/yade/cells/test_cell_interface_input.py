@@ -46,13 +46,21 @@ def engine(**extra):
 def before_first_step():
     flow = engine()
     calls = {
-        "getCellBarycenter": lambda: flow.getCellBarycenter(0), "getVertices": lambda: flow.getVertices(0),
-        "getNeighbors": lambda: flow.getNeighbors(0), "getCellPImposed": lambda: flow.getCellPImposed(0),
-        "setCellPImposed": lambda: flow.setCellPImposed(0, True), "blockCell": lambda: flow.blockCell(0, True),
-        "getCellFluxFromId": lambda: flow.getCellFluxFromId(0), "averageVelocity": flow.averageVelocity,
-        "getConstrictions": flow.getConstrictions, "volume": lambda: flow.volume(6), "exportMatrix": flow.exportMatrix,
-        "getIncidentCells": lambda: flow.getIncidentCells(6), "initializeVolumes": flow.initializeVolumes,
-        "getBoundaryFluidArea": lambda: flow.getBoundaryFluidArea(3), "cholmodStats": flow.cholmodStats,
+        "getCellBarycenter": lambda: flow.getCellBarycenter(0),
+        "getVertices": lambda: flow.getVertices(0),
+        "getNeighbors": lambda: flow.getNeighbors(0),
+        "getCellPImposed": lambda: flow.getCellPImposed(0),
+        "setCellPImposed": lambda: flow.setCellPImposed(0, True),
+        "blockCell": lambda: flow.blockCell(0, True),
+        "getCellFluxFromId": lambda: flow.getCellFluxFromId(0),
+        "averageVelocity": flow.averageVelocity,
+        "getConstrictions": flow.getConstrictions,
+        "volume": lambda: flow.volume(6),
+        "exportMatrix": flow.exportMatrix,
+        "getIncidentCells": lambda: flow.getIncidentCells(6),
+        "initializeVolumes": flow.initializeVolumes,
+        "getBoundaryFluidArea": lambda: flow.getBoundaryFluidArea(3),
+        "cholmodStats": flow.cholmodStats,
     }
     bad = [name for name, call in calls.items() if not raises(RuntimeError, call)]
     check("before the first step every cell member raises RuntimeError", not bad, ", ".join(bad))
@@ -64,19 +72,25 @@ def bad_arguments():
     O.run(1, True)
     n = flow.nCells()
     cases = [
-        (IndexError, lambda: flow.getCellBarycenter(n)), (IndexError, lambda: flow.getVertices(-1)),
-        (IndexError, lambda: flow.setCellPressure(n + 5, 0.0)), (IndexError, lambda: flow.getConductivity(0, 4)),
+        (IndexError, lambda: flow.getCellBarycenter(n)),
+        (IndexError, lambda: flow.getVertices(-1)),
+        (IndexError, lambda: flow.setCellPressure(n + 5, 0.0)),
+        (IndexError, lambda: flow.getConductivity(0, 4)),
         (IndexError, lambda: flow.surfaceSolidThroatInPore(0, -1)),
         (IndexError, lambda: flow.setBoundaryNormal(6, (0, 1, 0))),
         (IndexError, lambda: flow.getCellFlux(3)),
-        (TypeError, lambda: flow.getCellBarycenter(1.0)), (TypeError, lambda: flow.setCellPImposed(0, "yes")),
-        (TypeError, lambda: flow.setCellPressure(0, "1")), (ValueError, lambda: flow.setCellPressure(0, float("nan"))),
-        (ValueError, lambda: flow.getBoundaryFluidArea(17)), (ValueError, lambda: flow.volume(10**6)),
+        (TypeError, lambda: flow.getCellBarycenter(1.0)),
+        (TypeError, lambda: flow.setCellPImposed(0, "yes")),
+        (TypeError, lambda: flow.setCellPressure(0, "1")),
+        (ValueError, lambda: flow.setCellPressure(0, float("nan"))),
+        (ValueError, lambda: flow.getBoundaryFluidArea(17)),
+        (ValueError, lambda: flow.volume(10**6)),
         (ValueError, lambda: flow.getCellVelocity((5, 5, 5))),
         (NotImplementedError, lambda: flow.setBoundaryNormal(2, (0, -1, 0))),
         (ValueError, lambda: setattr(flow, "minimumPorosity", 1.0)),
         (ValueError, lambda: setattr(flow, "wallThickness", -1)),
-        (ValueError, lambda: setattr(flow, "numSolveThreads", 0)), (TypeError, lambda: setattr(flow, "blockHook", 3)),
+        (ValueError, lambda: setattr(flow, "numSolveThreads", 0)),
+        (TypeError, lambda: setattr(flow, "blockHook", 3)),
         (SyntaxError, lambda: setattr(flow, "blockHook", "flow.blockCell(")),
         (ValueError, lambda: setattr(flow, "boundaryXPos", [0.0, float("inf")])),
         (ValueError, lambda: setattr(flow, "flatThreshold", float("nan"))),
@@ -88,16 +102,31 @@ def bad_arguments():
     check("bad arguments raise the error that names them", not bad, f"cases {bad}")
     before = flow.getBoundaryFlux(3)
     O.run(1, True)
-    check("the engine still runs, unchanged, after the refused calls", abs(flow.getBoundaryFlux(3) - before)
-          <= 1e-12 * abs(before))
+    check(
+        "the engine still runs, unchanged, after the refused calls",
+        abs(flow.getBoundaryFlux(3) - before) <= 1e-12 * abs(before),
+    )
 
 
 def attributes_and_reports():
     flow = engine()
-    values = dict(numSolveThreads=2, numFactorizeThreads=3, permeabilityMap=True, ids=[6, 7], volumeFactor=2.0,
-                  boundaryVelocity=[(0, 0, 0)] * 5 + [(1, 0, 0)], meanK_opt=False, doInterpolate=True,
-                  minimumPorosity=0.1, flatThreshold=-1.0, idOffset=0, debug=True, getCHOLMODPerfTimings=True,
-                  meanKStat=True, iniVoidVolumes=True)
+    values = dict(
+        numSolveThreads=2,
+        numFactorizeThreads=3,
+        permeabilityMap=True,
+        ids=[6, 7],
+        volumeFactor=2.0,
+        boundaryVelocity=[(0, 0, 0)] * 5 + [(1, 0, 0)],
+        meanK_opt=False,
+        doInterpolate=True,
+        minimumPorosity=0.1,
+        flatThreshold=-1.0,
+        idOffset=0,
+        debug=True,
+        getCHOLMODPerfTimings=True,
+        meanKStat=True,
+        iniVoidVolumes=True,
+    )
     for name, value in values.items():
         setattr(flow, name, value)
     back = {name: getattr(flow, name) for name in values}
@@ -110,8 +139,11 @@ def attributes_and_reports():
     with contextlib.redirect_stdout(out):
         O.run(2, True)
     text = out.getvalue()
-    check("debug, getCHOLMODPerfTimings and meanKStat report", "pfv.FlowEngine: iter" in text
-          and "CHOLMOD Time to factorize" in text and "meanKStat (pfv)" in text, text[:200].replace("\n", " | "))
+    check(
+        "debug, getCHOLMODPerfTimings and meanKStat report",
+        "pfv.FlowEngine: iter" in text and "CHOLMOD Time to factorize" in text and "meanKStat (pfv)" in text,
+        text[:200].replace("\n", " | "),
+    )
     flow.debug = flow.getCHOLMODPerfTimings = flow.meanKStat = False
     # Printing outputs: they run (their YADE formats are compared in test_cell_interface_vs_yade.py).
     flow.cholmodStats()
@@ -121,13 +153,17 @@ def attributes_and_reports():
     flow.resetLinearSystem()
     builds = flow.core.system_builds
     O.run(1, True)
-    check("resetLinearSystem rebuilds the system, results unchanged",
-          flow.core.system_builds == builds + 1 and abs(flow.getBoundaryFlux(3) - q) <= 1e-12 * abs(q))
+    check(
+        "resetLinearSystem rebuilds the system, results unchanged",
+        flow.core.system_builds == builds + 1 and abs(flow.getBoundaryFlux(3) - q) <= 1e-12 * abs(q),
+    )
     flow.updateVolumes()
     flow.initializeVolumes()
     O.run(1, True)
-    check("updateVolumes/initializeVolumes on a frozen packing change nothing",
-          abs(flow.getBoundaryFlux(3) - q) <= 1e-12 * abs(q) and flow.epsVolMax == 0)
+    check(
+        "updateVolumes/initializeVolumes on a frozen packing change nothing",
+        abs(flow.getBoundaryFlux(3) - q) <= 1e-12 * abs(q) and flow.epsVolMax == 0,
+    )
 
 
 def conditions_and_remesh():
@@ -140,9 +176,12 @@ def conditions_and_remesh():
     held = flow.getCellPImposed(c)
     flow.updateTriangulation = True
     O.run(1, True)
-    check("conditions set on cells hold until the next remesh",
-          held and not flow.getCellPImposed(flow.getCell(0.5, 0.5, 0.5))
-          and not flow.core.cell_blocked(flow.getCell(0.3, 0.3, 0.3)))
+    check(
+        "conditions set on cells hold until the next remesh",
+        held
+        and not flow.getCellPImposed(flow.getCell(0.5, 0.5, 0.5))
+        and not flow.core.cell_blocked(flow.getCell(0.3, 0.3, 0.3)),
+    )
     # doInterpolate carries blocked cells over a remesh (as YADE's interpolation does).
     flow.doInterpolate = True
     b = flow.getCell(0.3, 0.3, 0.3)
@@ -151,8 +190,10 @@ def conditions_and_remesh():
     flow.updateTriangulation = True
     O.run(1, True)
     b = flow.getCell(0.3, 0.3, 0.3)
-    check("doInterpolate: a blocked cell stays blocked across a remesh", flow.core.cell_blocked(b)
-          and flow.getCellPressure(b) == 0)
+    check(
+        "doInterpolate: a blocked cell stays blocked across a remesh",
+        flow.core.cell_blocked(b) and flow.getCellPressure(b) == 0,
+    )
     # pressureForce=False: no step at all; the next step after has no dV/dt term.
     flow.pressureForce = False
     remeshes = flow.core.remesh_count
@@ -197,13 +238,18 @@ def clumps():
     q_clump, cells = flow.getBoundaryFlux(3), flow.nCells()
     plain = engine()
     O.run(1, True)
-    check("convertClumps=False: clump members coupled as spheres", cells == plain.nCells()
-          and abs(q_clump - plain.getBoundaryFlux(3)) <= 1e-9 * abs(q_clump), f"{cells} {plain.nCells()}")
+    check(
+        "convertClumps=False: clump members coupled as spheres",
+        cells == plain.nCells() and abs(q_clump - plain.getBoundaryFlux(3)) <= 1e-9 * abs(q_clump),
+        f"{cells} {plain.nCells()}",
+    )
     flow = engine()
     O.bodies.clump([a, b])
     O.run(1, True)
-    check("convertClumps=True: the clump is one vertex fewer than its members", flow.nCells() > 0
-          and len(flow._bodies.stepped.ids) == len(plain._bodies.stepped.ids) - 1)
+    check(
+        "convertClumps=True: the clump is one vertex fewer than its members",
+        flow.nCells() > 0 and len(flow._bodies.stepped.ids) == len(plain._bodies.stepped.ids) - 1,
+    )
 
 
 def main():

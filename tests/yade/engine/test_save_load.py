@@ -62,8 +62,13 @@ ref = run_sampled(10, lower_top_wall)
 O.loadTmp("mid")
 restored = builtins.flow
 rb.check("after O.loadTmp the label names a pfv.FlowEngine", type(restored) is FlowEngine and restored is not flow)
-rb.check("settings carried", restored.viscosity == 2.5 and restored.meshUpdateInterval == 7
-         and restored.tolerance == 1e-8 and len(restored.core.imposed_fluxes()) == 1)
+rb.check(
+    "settings carried",
+    restored.viscosity == 2.5
+    and restored.meshUpdateInterval == 7
+    and restored.tolerance == 1e-8
+    and len(restored.core.imposed_fluxes()) == 1,
+)
 rb.check("the mesh is there before the first step", restored.nCells() > 0)
 compare("moving wall, remesh in between", ref, run_sampled(10, lower_top_wall))
 
@@ -98,8 +103,10 @@ rb.scenes.insert_flow(fresh_engine)
 O.saveTmp("unrun")
 O.loadTmp("unrun")
 rb.run(1)
-rb.check("an engine saved before its first step runs after the load",
-         type(builtins.flow) is FlowEngine and builtins.flow.viscosity == 3.0 and builtins.flow.getBoundaryFlux(2) < 0)
+rb.check(
+    "an engine saved before its first step runs after the load",
+    type(builtins.flow) is FlowEngine and builtins.flow.viscosity == 3.0 and builtins.flow.getBoundaryFlux(2) < 0,
+)
 
 # 5. Conditions set on single cells (setCellPImposed, setCellPressure, blockCell) and the void
 # volumes of initializeVolumes hold until the next remesh: after a load, on the rebuilt mesh
@@ -118,19 +125,26 @@ flow.initializeVolumes()
 remeasured = np.flatnonzero(flow.core.void_volumes() != mesh_volumes)[:3].tolist()  # cells on the moved wall
 rb.check("initializeVolumes measures other void volumes than the mesh's", len(remeasured) == 3)
 run_sampled(1, lower_top_wall)
-rb.check("the cell conditions change the fluxes", abs(flow.getBoundaryFlux(2) - free_flux) > 1e-3 * abs(free_flux),
-         f"({flow.getBoundaryFlux(2):.6g} vs {free_flux:.6g})")
+rb.check(
+    "the cell conditions change the fluxes",
+    abs(flow.getBoundaryFlux(2) - free_flux) > 1e-3 * abs(free_flux),
+    f"({flow.getBoundaryFlux(2):.6g} vs {free_flux:.6g})",
+)
 inverse_volumes = [flow.getCellInvVoidVolume(c) for c in remeasured]
 O.saveTmp("cells")
 ref = run_sampled(6, lower_top_wall)
 O.loadTmp("cells")
 restored = builtins.flow
-rb.check("cells imposed before the save are imposed after the load",
-         all(restored.getCellPImposed(c) for c in imposed) and not restored.getCellPImposed(11))
+rb.check(
+    "cells imposed before the save are imposed after the load",
+    all(restored.getCellPImposed(c) for c in imposed) and not restored.getCellPImposed(11),
+)
 held = [restored.getPorePressure(restored.getCellBarycenter(c)) for c in imposed]
 rb.check("the imposed cells hold their pressures", held == [0.2 + 0.3 * k for k in range(3)], f"{held}")
-rb.check("the void volumes of initializeVolumes are carried",
-         [restored.getCellInvVoidVolume(c) for c in remeasured] == inverse_volumes)
+rb.check(
+    "the void volumes of initializeVolumes are carried",
+    [restored.getCellInvVoidVolume(c) for c in remeasured] == inverse_volumes,
+)
 compare("cell conditions and measured void volumes", ref, run_sampled(6, lower_top_wall))
 
 rb.report("save/load")

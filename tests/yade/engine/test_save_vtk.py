@@ -81,7 +81,7 @@ def cells(grid):
     types = vtk_to_numpy(grid.GetCellTypesArray())
     offsets = vtk_to_numpy(grid.GetCells().GetOffsetsArray())
     connectivity = vtk_to_numpy(grid.GetCells().GetConnectivityArray())
-    return types, [connectivity[offsets[k]:offsets[k + 1]] for k in range(len(types))]
+    return types, [connectivity[offsets[k] : offsets[k + 1]] for k in range(len(types))]
 
 
 def engine_state(flow):
@@ -89,16 +89,26 @@ def engine_state(flow):
     core = flow.core
     scan = flow._bodies.stepped
     ids = scan.ids
-    return dict(time=O.time, pressure=core.pressure(), velocity=core.cell_velocities(),
-                fluid_volume=core.cell_fluid_volumes(), volume=core.current_cell_volumes(),
-                source=core.cell_sources(), vertices=core.cell_vertices(), positions=core.positions(),
-                walls=np.array(core.walls()), forces=core.forces(), ids=ids.copy(), radii=scan.radii.copy(),
-                bodies=np.array([tuple(O.bodies[int(i)].state.pos) for i in ids]),
-                body_radii=np.array([O.bodies[int(i)].shape.radius for i in ids]),
-                fluid_force=np.array([tuple(flow.fluidForce(int(i))) for i in ids]),
-                wall_force=np.array([tuple(flow.fluidForce(w)) for w in range(6)]),
-                cell_pressure=np.array([flow.getCellPressure(c) for c in range(0, flow.nCells(), 97)]),
-                n_cells=flow.nCells())
+    return dict(
+        time=O.time,
+        pressure=core.pressure(),
+        velocity=core.cell_velocities(),
+        fluid_volume=core.cell_fluid_volumes(),
+        volume=core.current_cell_volumes(),
+        source=core.cell_sources(),
+        vertices=core.cell_vertices(),
+        positions=core.positions(),
+        walls=np.array(core.walls()),
+        forces=core.forces(),
+        ids=ids.copy(),
+        radii=scan.radii.copy(),
+        bodies=np.array([tuple(O.bodies[int(i)].state.pos) for i in ids]),
+        body_radii=np.array([O.bodies[int(i)].shape.radius for i in ids]),
+        fluid_force=np.array([tuple(flow.fluidForce(int(i))) for i in ids]),
+        wall_force=np.array([tuple(flow.fluidForce(w)) for w in range(6)]),
+        cell_pressure=np.array([flow.getCellPressure(c) for c in range(0, flow.nCells(), 97)]),
+        n_cells=flow.nCells(),
+    )
 
 
 def same(a, b):
@@ -128,30 +138,49 @@ def check_pores(path, state, with_boundaries, label):
     n = len(state["ids"])
     wall_count = (state["vertices"] >= n).sum(axis=1)
     kept = np.arange(state["n_cells"]) if with_boundaries else np.flatnonzero(wall_count == 0)
-    check(grid.GetNumberOfCells() == len(kept),
-          f"{label}: {grid.GetNumberOfCells()} cells = {len(kept)} "
-          f"({'every cell' if with_boundaries else 'cells without a wall vertex'} of {state['n_cells']})")
-    expected = dict(Pressure=(state["pressure"][kept], "double"), Velocity=(state["velocity"][kept], "double"),
-                    FluidVolume=(state["fluid_volume"][kept], "double"), Volume=(state["volume"][kept], "double"),
-                    Pcondition=((state["source"][kept] >= 0).astype(np.int32), "int"),
-                    PressureSource=(state["source"][kept], "int"), fictious=(wall_count[kept], "int"),
-                    id=(kept, "int"))
+    check(
+        grid.GetNumberOfCells() == len(kept),
+        f"{label}: {grid.GetNumberOfCells()} cells = {len(kept)} "
+        f"({'every cell' if with_boundaries else 'cells without a wall vertex'} of {state['n_cells']})",
+    )
+    expected = dict(
+        Pressure=(state["pressure"][kept], "double"),
+        Velocity=(state["velocity"][kept], "double"),
+        FluidVolume=(state["fluid_volume"][kept], "double"),
+        Volume=(state["volume"][kept], "double"),
+        Pcondition=((state["source"][kept] >= 0).astype(np.int32), "int"),
+        PressureSource=(state["source"][kept], "int"),
+        fictious=(wall_count[kept], "int"),
+        id=(kept, "int"),
+    )
     for name, (values, kind) in expected.items():
         got = data.get(name)
-        check(got is not None and got[1] == kind and same(got[0], values),
-              f"{label}: {name} ({kind}) equals the engine's")
-    check(same(data["Pressure"][0][np.searchsorted(kept, np.arange(0, state["n_cells"], 97))], state["cell_pressure"])
-          if with_boundaries else True, f"{label}: Pressure agrees with getCellPressure")
+        check(
+            got is not None and got[1] == kind and same(got[0], values), f"{label}: {name} ({kind}) equals the engine's"
+        )
+    check(
+        same(data["Pressure"][0][np.searchsorted(kept, np.arange(0, state["n_cells"], 97))], state["cell_pressure"])
+        if with_boundaries
+        else True,
+        f"{label}: Pressure agrees with getCellPressure",
+    )
     points = vtk_to_numpy(grid.GetPoints().GetData())
-    check(grid.GetPoints().GetData().GetDataTypeAsString() == "double" and same(points[:n], state["positions"])
-          and same(points[:n], state["bodies"]), f"{label}: points 0..n-1 are the sphere centres (Float64)")
+    check(
+        grid.GetPoints().GetData().GetDataTypeAsString() == "double"
+        and same(points[:n], state["positions"])
+        and same(points[:n], state["bodies"]),
+        f"{label}: points 0..n-1 are the sphere centres (Float64)",
+    )
     field = arrays(grid.GetFieldData())
     check(same(field["TimeValue"][0], [state["time"]]), f"{label}: TimeValue = O.time of the call")
     types, members = cells(grid)
     type_of = np.array([VTK_TETRA, VTK_WEDGE, VTK_HEXAHEDRON, VTK_HEXAHEDRON])
     check(same(types, type_of[wall_count[kept]]), f"{label}: tetrahedra, wedges (1 wall), hexahedra (2, 3 walls)")
-    bad = [c for c, m in zip(kept, members)
-           if not same(np.unique(points[m], axis=0), expected_points(state, state["vertices"][c]))]
+    bad = [
+        c
+        for c, m in zip(kept, members)
+        if not same(np.unique(points[m], axis=0), expected_points(state, state["vertices"][c]))
+    ]
     check(not bad, f"{label}: each cell's points are its sphere centres and their wall projections ({len(bad)} not)")
     sizes = vtkCellSizeFilter()
     sizes.SetInputData(grid)
@@ -159,20 +188,30 @@ def check_pores(path, state, with_boundaries, label):
     vtk_volume = vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume"))
     volume = state["volume"][kept]
     error = np.max(np.abs(vtk_volume - volume) / volume)
-    check(vtk_volume.min() > 0 and error < 1e-12,
-          f"{label}: VTK's cell volumes are positive and equal Volume (largest relative difference {error:.1e})")
+    check(
+        vtk_volume.min() > 0 and error < 1e-12,
+        f"{label}: VTK's cell volumes are positive and equal Volume (largest relative difference {error:.1e})",
+    )
     if with_boundaries:
         walls = state["walls"]
         box = (walls[1] - walls[0]) * (walls[3] - walls[2]) * (walls[5] - walls[4])
-        check(math.isclose(vtk_volume.sum(), box, rel_tol=1e-12),
-              f"{label}: the cells tile the box (sum of VTK volumes {vtk_volume.sum():.15g}, box {box:.15g})")
-        check(len(np.unique(points, axis=0)) == len(points),
-              f"{label}: no point twice ({len(points)} points): neighbouring cells share their wall points")
+        check(
+            math.isclose(vtk_volume.sum(), box, rel_tol=1e-12),
+            f"{label}: the cells tile the box (sum of VTK volumes {vtk_volume.sum():.15g}, box {box:.15g})",
+        )
+        check(
+            len(np.unique(points, axis=0)) == len(points),
+            f"{label}: no point twice ({len(points)} points): neighbouring cells share their wall points",
+        )
         imposed = data["PressureSource"][0]
-        check((imposed == 2).sum() > 0 and (imposed == 3).sum() > 0 and (imposed == 6).sum() == 1
-              and set(np.unique(imposed)) == {-1, 2, 3, 6},
-              f"{label}: imposed pressure in the cells of walls 2, 3 and of the imposed point "
-              f"({[(int(v), int((imposed == v).sum())) for v in np.unique(imposed)]})")
+        check(
+            (imposed == 2).sum() > 0
+            and (imposed == 3).sum() > 0
+            and (imposed == 6).sum() == 1
+            and set(np.unique(imposed)) == {-1, 2, 3, 6},
+            f"{label}: imposed pressure in the cells of walls 2, 3 and of the imposed point "
+            f"({[(int(v), int((imposed == v).sum())) for v in np.unique(imposed)]})",
+        )
     return grid
 
 
@@ -183,15 +222,25 @@ def check_spheres(path, state, label):
     points = vtk_to_numpy(grid.GetPoints().GetData())
     check(grid.GetNumberOfPoints() == n and same(points, state["bodies"]), f"{label}: points are the sphere centres")
     types, members = cells(grid)
-    check(same(types, np.full(n, VTK_VERTEX)) and same(np.concatenate(members), np.arange(n)),
-          f"{label}: one vertex cell per sphere")
+    check(
+        same(types, np.full(n, VTK_VERTEX)) and same(np.concatenate(members), np.arange(n)),
+        f"{label}: one vertex cell per sphere",
+    )
     check(data["radii"][1] == "double" and same(data["radii"][0], state["body_radii"]), f"{label}: radii")
     check(same(data["id"][0], state["ids"]), f"{label}: id = YADE ids")
-    check(data["fluidForce"][1] == "double" and same(data["fluidForce"][0], state["fluid_force"])
-          and same(data["fluidForce"][0], state["forces"][:n]), f"{label}: fluidForce = fluidForce(id)")
+    check(
+        data["fluidForce"][1] == "double"
+        and same(data["fluidForce"][0], state["fluid_force"])
+        and same(data["fluidForce"][0], state["forces"][:n]),
+        f"{label}: fluidForce = fluidForce(id)",
+    )
     field = arrays(grid.GetFieldData())
-    check(same(field["wallIds"][0], np.arange(6)) and same(field["wallPositions"][0], state["walls"])
-          and same(field["wallFluidForce"][0], state["wall_force"]), f"{label}: walls' ids, positions, fluid forces")
+    check(
+        same(field["wallIds"][0], np.arange(6))
+        and same(field["wallPositions"][0], state["walls"])
+        and same(field["wallFluidForce"][0], state["wall_force"]),
+        f"{label}: walls' ids, positions, fluid forces",
+    )
     check(same(field["TimeValue"][0], [state["time"]]), f"{label}: TimeValue = O.time of the call")
     return grid
 
@@ -244,14 +293,20 @@ try:
     tree = ElementTree.parse(os.path.join(plain, "out.pvd")).getroot()
     entries = [d.attrib for d in tree.iter("DataSet")]
     listed = [(float(e["timestep"]), e["part"], e["name"], e["file"]) for e in entries]
-    wanted = [(s["time"], part, name, f"{prefix}_{k}.vtu") for k, s in enumerate(states)
-              for part, name, prefix in (("0", "pores", "out"), ("1", "spheres", "spheres"))]
-    check(tree.get("type") == "Collection" and listed == wanted,
-          f"out.pvd lists both snapshots at their times: {listed}")
+    wanted = [
+        (s["time"], part, name, f"{prefix}_{k}.vtu")
+        for k, s in enumerate(states)
+        for part, name, prefix in (("0", "pores", "out"), ("1", "spheres", "spheres"))
+    ]
+    check(
+        tree.get("type") == "Collection" and listed == wanted, f"out.pvd lists both snapshots at their times: {listed}"
+    )
     for e in entries:
         grid = read(os.path.join(plain, e["file"]))
-        check(same(arrays(grid.GetFieldData())["TimeValue"][0], [float(e["timestep"])]),
-              f"{e['file']} read through out.pvd: TimeValue = its timestep")
+        check(
+            same(arrays(grid.GetFieldData())["TimeValue"][0], [float(e["timestep"])]),
+            f"{e['file']} read through out.pvd: TimeValue = its timestep",
+        )
 
     # 3-5. Every file against the engine's values at its call.
     for k, state in enumerate(states):
@@ -264,8 +319,10 @@ try:
             with open(packed, "rb") as f:
                 header = f.read(400)
             smaller = os.path.getsize(packed) < os.path.getsize(os.path.join(boundaries, name))
-            check(b'compressor="vtkZLibDataCompressor"' in header and smaller and same_grids(read(packed), grid),
-                  f"compressed {name}: zlib, smaller, same data")
+            check(
+                b'compressor="vtkZLibDataCompressor"' in header and smaller and same_grids(read(packed), grid),
+                f"compressed {name}: zlib, smaller, same data",
+            )
 finally:
     shutil.rmtree(root, ignore_errors=True)
 

@@ -59,8 +59,11 @@ def main():
         if row["yade"] != "-":
             seen["FlowEngine"] = through_flow_engine(row)
         print(f"{row['core']:30s} expected {row['rebuild']:7s} seen {seen}")
-        failures += [f"{row['core']} through {api}: {got}, expected {row['rebuild']}"
-                     for api, got in seen.items() if got != row["rebuild"]]
+        failures += [
+            f"{row['core']} through {api}: {got}, expected {row['rebuild']}"
+            for api, got in seen.items()
+            if got != row["rebuild"]
+        ]
     if len(rows) < 20:
         failures.append(f"the table has only {len(rows)} rows")
     for f in failures:

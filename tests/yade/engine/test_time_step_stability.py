@@ -131,7 +131,7 @@ def run_steps(n, ke0, stop_ratio=None):
             except Exception as e:  # noqa: BLE001  (a broken-down run: spheres leave the box, NaN...)
                 error = str(e).strip().splitlines()[-1][:160] if str(e).strip() else type(e).__name__
                 break
-            for w in caught[len(seen):]:
+            for w in caught[len(seen) :]:
                 seen.append((O.iter, w))
             ke = kinetic()
             hist.append(ke / ke0 if math.isfinite(ke) else float("inf"))
@@ -142,16 +142,20 @@ def run_steps(n, ke0, stop_ratio=None):
 
 # 1. dt_MV --------------------------------------------------------------------------------------------------------
 flow = build()
-rho_d2 = min(b.material.density * (2 * b.shape.radius) ** 2 for b in O.bodies
-             if isinstance(b.shape, Sphere) and b.dynamic)
+rho_d2 = min(
+    b.material.density * (2 * b.shape.radius) ** 2 for b in O.bodies if isinstance(b.shape, Sphere) and b.dynamic
+)
 dt_mv_formula = math.pi * rho_d2 / (1200 * MU)
 dt_mv = flow.viscous_time_step
 dt_dem = utils.PWaveTimeStep()
-check(abs(dt_mv / dt_mv_formula - 1) < 1e-9,
-      "dt_MV = %.6g s = pi rho d^2 / (1200 mu) = %.6g s" % (dt_mv, dt_mv_formula))
-check(abs(flow.critical_time_step / min(dt_mv, dt_dem) - 1) < 1e-9,
-      "critical_time_step %.6g s = min(dt_MV, P-wave %.6g s); dt_DEM / dt_MV = %.1f"
-      % (flow.critical_time_step, dt_dem, dt_dem / dt_mv))
+check(
+    abs(dt_mv / dt_mv_formula - 1) < 1e-9, "dt_MV = %.6g s = pi rho d^2 / (1200 mu) = %.6g s" % (dt_mv, dt_mv_formula)
+)
+check(
+    abs(flow.critical_time_step / min(dt_mv, dt_dem) - 1) < 1e-9,
+    "critical_time_step %.6g s = min(dt_MV, P-wave %.6g s); dt_DEM / dt_MV = %.1f"
+    % (flow.critical_time_step, dt_dem, dt_dem / dt_mv),
+)
 
 # 2. 1.5 dt_MV: warned first, then blows up -----------------------------------------------------------------------
 O.dt = 1.5 * dt_mv
@@ -160,17 +164,24 @@ it0 = O.iter
 hist, seen, error = run_steps(60, ke0, stop_ratio=1e12)
 dt_warnings = [(i - it0, w) for i, w in seen if issubclass(w.category, TimeStepWarning)]
 grown = [k for k, r in enumerate(hist, 1) if r > 10]
-print("     1.5 dt_MV: KE/KE0 after steps 1..%d: %s%s" % (len(hist), " ".join("%.3g" % r for r in hist[:25]),
-                                                          (" ... run stopped: " + error) if error else ""))
+print(
+    "     1.5 dt_MV: KE/KE0 after steps 1..%d: %s%s"
+    % (len(hist), " ".join("%.3g" % r for r in hist[:25]), (" ... run stopped: " + error) if error else "")
+)
 check(len(dt_warnings) == 1, "one TimeStepWarning at 1.5 dt_MV (got %d)" % len(dt_warnings))
 if dt_warnings:
     step_w, w = dt_warnings[0]
     check(step_w == 1, "warned at coupled step %d (the first): %s" % (step_w, str(w.message)[:120]))
-    check(not grown or step_w < grown[0], "warned (step %d) before the kinetic energy grew tenfold (step %s)"
-          % (step_w, grown[0] if grown else "never"))
+    check(
+        not grown or step_w < grown[0],
+        "warned (step %d) before the kinetic energy grew tenfold (step %s)" % (step_w, grown[0] if grown else "never"),
+    )
 blew = max(hist, default=0) > 1e6 or (error is not None and max(hist, default=0) > 10)
-check(blew, "1.5 dt_MV blows up: max KE/KE0 = %.3g within %d steps%s"
-      % (max(hist, default=0), len(hist), (" (then: %s)" % error) if error else ""))
+check(
+    blew,
+    "1.5 dt_MV blows up: max KE/KE0 = %.3g within %d steps%s"
+    % (max(hist, default=0), len(hist), (" (then: %s)" % error) if error else ""),
+)
 
 # 3. strict_time_step raises ---------------------------------------------------------------------------------------
 flow = build()
@@ -184,9 +195,11 @@ with warnings.catch_warnings(record=True) as caught:
         raised = None
     except RuntimeError as e:
         raised = str(e)
-check(raised is not None and "exceeds the coupled stability limit" in raised,
-      "strict_time_step: the step raises naming the limit (%s)"
-      % ((raised or "no error").strip().splitlines()[-1][:110] if raised else "no error"))
+check(
+    raised is not None and "exceeds the coupled stability limit" in raised,
+    "strict_time_step: the step raises naming the limit (%s)"
+    % ((raised or "no error").strip().splitlines()[-1][:110] if raised else "no error"),
+)
 check(O.iter == it0, "strict_time_step: O.iter did not advance (%d -> %d)" % (it0, O.iter))
 check(not [w for w in caught if issubclass(w.category, TimeStepWarning)], "strict_time_step: raises instead of warning")
 try:
@@ -207,12 +220,20 @@ def stable_run(factor, label, flow=None):
     O.dt = factor * flow.viscous_time_step
     ke0 = kinetic()
     hist, seen, error = run_steps(300, ke0, stop_ratio=1e12)
-    print("     %.3g dt_MV: KE/KE0 at steps 1, 10, 50, 100, 300: %s%s" % (
-        factor, " ".join("%.3g" % hist[k - 1] for k in (1, 10, 50, 100, 300) if k <= len(hist)),
-        (" ... run stopped: " + error) if error else ""))
+    print(
+        "     %.3g dt_MV: KE/KE0 at steps 1, 10, 50, 100, 300: %s%s"
+        % (
+            factor,
+            " ".join("%.3g" % hist[k - 1] for k in (1, 10, 50, 100, 300) if k <= len(hist)),
+            (" ... run stopped: " + error) if error else "",
+        )
+    )
     ok = error is None and len(hist) == 300 and max(hist) < 2 and hist[-1] < 1
-    check(ok, "%s: O.dt = %.3g dt_MV is stable (max KE/KE0 %.3g over %d steps, final %.3g)"
-          % (label, factor, max(hist, default=float('nan')), len(hist), hist[-1] if hist else float('nan')))
+    check(
+        ok,
+        "%s: O.dt = %.3g dt_MV is stable (max KE/KE0 %.3g over %d steps, final %.3g)"
+        % (label, factor, max(hist, default=float('nan')), len(hist), hist[-1] if hist else float('nan')),
+    )
     return ok, seen
 
 
@@ -224,18 +245,24 @@ flow = build()
 O.dt = 1e-3 * flow.viscous_time_step
 O.step()
 dt_collective = flow.collective_viscous_time_step
-print("     collective viscous limit 2 / lambda_max(M^-1 V) = %.4g s = %.3f dt_MV (Arnoldi on the engine's "
-      "linearised fluid operator; the thesis' single-particle dt_MV is not a safe bound for collective modes)"
-      % (dt_collective, dt_collective / dt_mv))
+print(
+    "     collective viscous limit 2 / lambda_max(M^-1 V) = %.4g s = %.3f dt_MV (Arnoldi on the engine's "
+    "linearised fluid operator; the thesis' single-particle dt_MV is not a safe bound for collective modes)"
+    % (dt_collective, dt_collective / dt_mv)
+)
 check(dt_collective < dt_mv, "the collective limit is below dt_MV on this dense packing")
 bound = flow.collective_viscous_bound
-check(0.1 * dt_collective < bound <= dt_collective,
-      "collective_viscous_bound %.3g dt_MV: certified below the limit, within an order of magnitude of it"
-      % (bound / dt_mv))
+check(
+    0.1 * dt_collective < bound <= dt_collective,
+    "collective_viscous_bound %.3g dt_MV: certified below the limit, within an order of magnitude of it"
+    % (bound / dt_mv),
+)
 factor = flow.time_step_safety * flow.critical_time_step / flow.viscous_time_step
 ok, seen = stable_run(factor, "engine limit")
-check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
-      "no TimeStepWarning at O.dt = time_step_safety * critical_time_step = %.3g dt_MV" % factor)
+check(
+    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
+    "no TimeStepWarning at O.dt = time_step_safety * critical_time_step = %.3g dt_MV" % factor,
+)
 
 # 6. the limit follows the compaction: recomputed at the remesh, warned there ------------------------------------------
 flow = build()
@@ -247,8 +274,10 @@ O.dt = flow.time_step_safety * flow.critical_time_step  # accepted silently on t
 factor = O.dt / dt_mv
 random_velocities()
 hist, seen, error = run_steps(5, kinetic())
-check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)], "loose packing at %.3g dt_MV: no warning"
-      % factor)
+check(
+    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
+    "loose packing at %.3g dt_MV: no warning" % factor,
+)
 compact(flow)
 random_velocities()
 ke0 = kinetic()
@@ -257,37 +286,61 @@ hist, seen, error = run_steps(100, ke0, stop_ratio=1e12)
 records = flow.collective_viscous_history
 history = [h for h in records if h["method"] != "bound"]  # the computations of the limit itself
 dt_warnings = [(i - it0, w) for i, w in seen if issubclass(w.category, TimeStepWarning)]
-print("     collective limit: %s" % "; ".join(
-    "%.3f dt_MV at iter %d (%d iterations, %s, %.1f ms)" % (h["limit"] / dt_mv, h["iter"], h["iterations"],
-                                                            "warm" if h["warm"] else "cold", 1e3 * h["seconds"])
-    for h in history))
+print(
+    "     collective limit: %s"
+    % "; ".join(
+        "%.3f dt_MV at iter %d (%d iterations, %s, %.1f ms)"
+        % (h["limit"] / dt_mv, h["iter"], h["iterations"], "warm" if h["warm"] else "cold", 1e3 * h["seconds"])
+        for h in history
+    )
+)
 remesh = sum(flow.core.remesh_times().values())
-print("     last remesh %.1f ms; warm-started limit on the compacted packing %.1f ms (%.0f %% of it)"
-      % (1e3 * remesh, 1e3 * history[-1]["seconds"], 100 * history[-1]["seconds"] / remesh))
+print(
+    "     last remesh %.1f ms; warm-started limit on the compacted packing %.1f ms (%.0f %% of it)"
+    % (1e3 * remesh, 1e3 * history[-1]["seconds"], 100 * history[-1]["seconds"] / remesh)
+)
 # history[0]: the first mesh; history[1]: the remesh onto the compacted packing (a blown-up run may remesh again later)
-check(len(history) >= 2 and history[1]["warm"] and history[1]["iter"] == it0,
-      "the limit was recomputed (warm start) on the new mesh, at the remesh step")
+check(
+    len(history) >= 2 and history[1]["warm"] and history[1]["iter"] == it0,
+    "the limit was recomputed (warm start) on the new mesh, at the remesh step",
+)
 compacted = history[1]["limit"] if len(history) >= 2 else loose
 # The guard asks the certified bound first: on the loose packing at 1e-4 dt_MV it sufficed (no limit computed by
 # the guard at that step, only by the query after it), on the compacted one at the step near the limit it did not.
 bounds = [h for h in records if h["method"] == "bound"]
-check(len(records) >= 4 and records[0]["method"] == "bound" and records[1]["method"] == "arnoldi"
-      and records[1]["iter"] == records[0]["iter"] + 1 and first_dt <= flow.time_step_safety * records[0]["limit"]
-      and records[2]["method"] == "bound" and records[3]["method"] == "power" and O.dt > 0.8 * records[2]["limit"],
-      "the guard's order: bound on the first mesh (sufficed at 1e-4 dt_MV), the limit when queried; bound on the "
-      "compacted mesh (not enough at %.3g dt_MV), then the limit (got %s)"
-      % (factor, [(h["method"], h["iter"]) for h in records[:4]]))
-check(all(0 < b["limit"] <= h["limit"] for b, h in zip(bounds[:2], history[:2])),
-      "each bound lies below the limit of its mesh (%s)" % "; ".join(
-          "%.3g <= %.3g dt_MV" % (b["limit"] / dt_mv, h["limit"] / dt_mv) for b, h in zip(bounds, history)))
-check(compacted < 0.85 * loose, "compaction by %g %% lowers the collective limit from %.3f to %.3f dt_MV"
-      % (100 * (1 - COMPACTION), loose / dt_mv, compacted / dt_mv))
-check(len(dt_warnings) == 1 and dt_warnings[0][0] == 1,
-      "one TimeStepWarning, at the remesh step (got %s)" % [k for k, _ in dt_warnings])
+check(
+    len(records) >= 4
+    and records[0]["method"] == "bound"
+    and records[1]["method"] == "arnoldi"
+    and records[1]["iter"] == records[0]["iter"] + 1
+    and first_dt <= flow.time_step_safety * records[0]["limit"]
+    and records[2]["method"] == "bound"
+    and records[3]["method"] == "power"
+    and O.dt > 0.8 * records[2]["limit"],
+    "the guard's order: bound on the first mesh (sufficed at 1e-4 dt_MV), the limit when queried; bound on the "
+    "compacted mesh (not enough at %.3g dt_MV), then the limit (got %s)"
+    % (factor, [(h["method"], h["iter"]) for h in records[:4]]),
+)
+check(
+    all(0 < b["limit"] <= h["limit"] for b, h in zip(bounds[:2], history[:2])),
+    "each bound lies below the limit of its mesh (%s)"
+    % "; ".join("%.3g <= %.3g dt_MV" % (b["limit"] / dt_mv, h["limit"] / dt_mv) for b, h in zip(bounds, history)),
+)
+check(
+    compacted < 0.85 * loose,
+    "compaction by %g %% lowers the collective limit from %.3f to %.3f dt_MV"
+    % (100 * (1 - COMPACTION), loose / dt_mv, compacted / dt_mv),
+)
+check(
+    len(dt_warnings) == 1 and dt_warnings[0][0] == 1,
+    "one TimeStepWarning, at the remesh step (got %s)" % [k for k, _ in dt_warnings],
+)
 grown = [k for k, r in enumerate(hist, 1) if r > 10]
-check(max(hist, default=0) > 1e6 and (not dt_warnings or not grown or dt_warnings[0][0] < grown[0]),
-      "the compacted packing at %.3g dt_MV (%.2f x its limit) blows up: max KE/KE0 %.3g, after the warning"
-      % (factor, O.dt / compacted, max(hist, default=0)))
+check(
+    max(hist, default=0) > 1e6 and (not dt_warnings or not grown or dt_warnings[0][0] < grown[0]),
+    "the compacted packing at %.3g dt_MV (%.2f x its limit) blows up: max KE/KE0 %.3g, after the warning"
+    % (factor, O.dt / compacted, max(hist, default=0)),
+)
 
 flow = build()
 O.dt = 1e-3 * flow.viscous_time_step
@@ -302,8 +355,10 @@ try:
     raised = None
 except RuntimeError as e:
     raised = str(e)
-check(raised is not None and "collective viscous limit" in raised and O.iter == it0,
-      "strict_time_step: the remesh step on the compacted packing raises, O.iter unchanged")
+check(
+    raised is not None and "collective viscous limit" in raised and O.iter == it0,
+    "strict_time_step: the remesh step on the compacted packing raises, O.iter unchanged",
+)
 
 flow = build()
 O.dt = 1e-3 * flow.viscous_time_step
@@ -311,8 +366,10 @@ O.step()
 compact(flow)
 O.step()
 ok, seen = stable_run(flow.time_step_safety * flow.critical_time_step / dt_mv, "compacted, its engine limit", flow)
-check(not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
-      "no TimeStepWarning at time_step_safety * critical_time_step of the compacted packing")
+check(
+    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
+    "no TimeStepWarning at time_step_safety * critical_time_step of the compacted packing",
+)
 
 print("%d failed" % len(failures))
 sys.exit(1 if failures else 0)

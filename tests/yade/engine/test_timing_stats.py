@@ -21,15 +21,25 @@ out = io.StringIO()
 with contextlib.redirect_stdout(out):
     timing.stats()
 report = out.getvalue()
-rb.check("timing.stats() lists the stages under the engine", all(
-    label in report
-    for label in ("solve", "dV/dt", "remesh: triangulation", "system: factorization", "forces to YADE")))
+rb.check(
+    "timing.stats() lists the stages under the engine",
+    all(
+        label in report
+        for label in ("solve", "dV/dt", "remesh: triangulation", "system: factorization", "forces to YADE")
+    ),
+)
 rb.check("every step counts once in the per-step stages", data["solve"][1] == 20 and data["forces to YADE"][1] == 20)
-rb.check("the remesh stages count the remeshes", data["remesh: triangulation"][1] == remeshes == 4,
-         f"({data['remesh: triangulation'][1]} vs {remeshes})")
+rb.check(
+    "the remesh stages count the remeshes",
+    data["remesh: triangulation"][1] == remeshes == 4,
+    f"({data['remesh: triangulation'][1]} vs {remeshes})",
+)
 total = sum(ns for ns, _ in data.values())
-rb.check("the stages add up to no more than the engine's time", 0 < total <= flow.execTime,
-         f"({total / 1e6:.1f} ms of {flow.execTime / 1e6:.1f} ms)")
+rb.check(
+    "the stages add up to no more than the engine's time",
+    0 < total <= flow.execTime,
+    f"({total / 1e6:.1f} ms of {flow.execTime / 1e6:.1f} ms)",
+)
 timing.reset()
 rb.check("timing.reset() clears them", flow.timingDeltas.data == [])
 rb.report("timing")

@@ -50,36 +50,57 @@ def run(use_pack):
         if k == ERASE_AT:
             O.bodies.erase(victim)
         O.run(1, True)
-        steps.append(dict(p=np.array(flow.core.pressure()), f=np.array(flow.core.forces()),
-                          remeshes=flow.core.remesh_count, spheres=len(flow._bodies.scan.ids)))
+        steps.append(
+            dict(
+                p=np.array(flow.core.pressure()),
+                f=np.array(flow.core.forces()),
+                remeshes=flow.core.remesh_count,
+                spheres=len(flow._bodies.scan.ids),
+            )
+        )
     centres = flow._bodies.read_positions()[0]
     python = np.array([tuple(O.bodies[int(i)].state.pos) for i in flow._bodies.scan.ids])
     moved = np.abs(python[:ERASE_AT] - start[:ERASE_AT]).max()
-    return dict(flow=flow, source=flow.position_source, steps=steps, centres=centres, python=python,
-                moved=moved, ids=list(flow._bodies.scan.ids))
+    return dict(
+        flow=flow,
+        source=flow.position_source,
+        steps=steps,
+        centres=centres,
+        python=python,
+        moved=moved,
+        ids=list(flow._bodies.scan.ids),
+    )
 
 
-check(_core.sphere_pack_size(SpherePack()) == 0,
-      "this build reads YADE's SpherePack (Boost.Python found and the layout recognised)")
+check(
+    _core.sphere_pack_size(SpherePack()) == 0,
+    "this build reads YADE's SpherePack (Boost.Python found and the layout recognised)",
+)
 fast, lists = run(True), run(False)
 check(fast["source"] == "SpherePack", f"default reader: {fast['source']}")
 check(lists["source"] == "coordinate lists", f"reader with the pack switched off: {lists['source']}")
 check(fast["moved"] > 1e-9, f"the spheres move under the drag (largest displacement {fast['moved']:.3g})")
 for name, run_ in (("SpherePack", fast), ("coordinate lists", lists)):
-    check(np.array_equal(run_["centres"], run_["python"]),
-          f"{name}: every centre read equals b.state.pos after the run")
+    check(
+        np.array_equal(run_["centres"], run_["python"]), f"{name}: every centre read equals b.state.pos after the run"
+    )
     before, after = run_["steps"][ERASE_AT - 1], run_["steps"][ERASE_AT]
-    check(after["remeshes"] == before["remeshes"] + 1 and after["spheres"] == before["spheres"] - 1,
-          f"{name}: erasing sphere #{victim} (len(O.bodies) unchanged) -> rescan and remesh "
-          f"({before['spheres']} -> {after['spheres']} spheres, remesh {before['remeshes']} -> {after['remeshes']})")
+    check(
+        after["remeshes"] == before["remeshes"] + 1 and after["spheres"] == before["spheres"] - 1,
+        f"{name}: erasing sphere #{victim} (len(O.bodies) unchanged) -> rescan and remesh "
+        f"({before['spheres']} -> {after['spheres']} spheres, remesh {before['remeshes']} -> {after['remeshes']})",
+    )
     check(victim not in run_["ids"], f"{name}: the erased sphere is out of the flow")
-same = all(np.array_equal(a["p"], b["p"]) and np.array_equal(a["f"], b["f"])
-           for a, b in zip(fast["steps"], lists["steps"]))
+same = all(
+    np.array_equal(a["p"], b["p"]) and np.array_equal(a["f"], b["f"]) for a, b in zip(fast["steps"], lists["steps"])
+)
 check(same, f"pressures and forces identical to the bit at all {STEPS} steps of both readers")
 
 # The low-level functions refuse what they cannot read.
-check(_core.sphere_pack_size(O.forces) == -1 and _core.sphere_pack_size(3.0) == -1,
-      "sphere_pack_size is -1 for objects that are no SpherePack")
+check(
+    _core.sphere_pack_size(O.forces) == -1 and _core.sphere_pack_size(3.0) == -1,
+    "sphere_pack_size is -1 for objects that are no SpherePack",
+)
 pack = SpherePack()
 pack.fromSimulation()
 n = _core.sphere_pack_size(pack)
@@ -97,15 +118,20 @@ def raises(kind, action):
 message = raises(ValueError, lambda: _core.gather_sphere_pack(O.forces, np.arange(2), np.empty((2, 3))))
 check(message is not None and "SpherePack" in message, f"gather from a non-pack: ValueError ({message})")
 out = np.full((2, 3), 7.0)
-check(not _core.gather_sphere_pack(pack, np.arange(2), out, None, n + 1) and (out == 7.0).all()
-      and _core.gather_sphere_pack(pack, np.arange(2), out, None, n) and (out != 7.0).any(),
-      "gather with the wrong expected size returns False and writes nothing; with the right one True")
+check(
+    not _core.gather_sphere_pack(pack, np.arange(2), out, None, n + 1)
+    and (out == 7.0).all()
+    and _core.gather_sphere_pack(pack, np.arange(2), out, None, n)
+    and (out != 7.0).any(),
+    "gather with the wrong expected size returns False and writes nothing; with the right one True",
+)
 message = raises(IndexError, lambda: _core.gather_sphere_pack(pack, np.array([n]), np.empty((1, 3))))
 check(message is not None and "outside the pack" in message, f"index beyond the pack: IndexError ({message})")
 message = raises(ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(3), np.empty((2, 3))))
 check(message is not None and "shape" in message, f"centres of the wrong shape: ValueError ({message})")
-message = raises(ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(2), np.empty((2, 3)),
-                                                              np.empty(2, dtype=np.float32)))
+message = raises(
+    ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(2), np.empty((2, 3)), np.empty(2, dtype=np.float32))
+)
 check(message is not None and "radii" in message, f"radii not float64: ValueError ({message})")
 
 # Forces: the bridge calls YADE's force_add (the function O.forces.addF is bound to) directly;
@@ -117,8 +143,10 @@ scenes.build_permeameter(num=1000, frozen=False)
 n_bodies = len(O.bodies)
 ids = np.array([b.id for b in O.bodies], dtype=np.int64)
 rows = np.arange(len(ids), dtype=np.int64)[::-1].copy()  # any row order
-F = (np.random.default_rng(7).normal(size=(len(ids), 3))
-     * 10.0 ** np.random.default_rng(8).integers(-6, 6, len(ids))[:, None])
+F = (
+    np.random.default_rng(7).normal(size=(len(ids), 3))
+    * 10.0 ** np.random.default_rng(8).integers(-6, 6, len(ids))[:, None]
+)
 bridge = _core.YadeForceBridge(Vector3, ids, rows)
 check(bridge.calls_yade_directly, "the bridge found YADE's force_add")
 
@@ -151,12 +179,15 @@ engine = _core.Engine()
 engine.bnd_is_pressure = [False, False, True, True, False, False]
 engine.bnd_value = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
 engine.step(pos, rad, [low[0], high[0], low[1], high[1], low[2], high[2]], 1e-4)
-sphere_bridge = _core.YadeForceBridge(Vector3, np.array([b.id for b in spheres], dtype=np.int64),
-                                      np.arange(len(spheres), dtype=np.int64))
+sphere_bridge = _core.YadeForceBridge(
+    Vector3, np.array([b.id for b in spheres], dtype=np.int64), np.arange(len(spheres), dtype=np.int64)
+)
 from_engine = forces_after(lambda add: sphere_bridge.apply(add, engine))
 from_array = forces_after(lambda add: sphere_bridge.apply(add, engine.forces()))
-check(np.array_equal(from_engine, from_array) and np.abs(from_engine).max() > 0,
-      "apply(addF, engine) writes what apply(addF, engine.forces()) writes")
+check(
+    np.array_equal(from_engine, from_array) and np.abs(from_engine).max() > 0,
+    "apply(addF, engine) writes what apply(addF, engine.forces()) writes",
+)
 message = raises(ValueError, lambda: bridge.apply(O.forces.addF, engine))  # one force row per body of the scene
 check(message is None, "an engine with enough force rows is accepted")
 message = raises(ValueError, lambda: bad.apply(O.forces.addF, _core.Engine()))

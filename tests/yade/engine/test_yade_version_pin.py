@@ -39,13 +39,17 @@ for other in ("2024.06a", "2023.02", "3.14"):
         expect(f"{other} is refused", False)
     except YadeVersionError as error:
         message = str(error)
-        expect(f"{other} is refused with an ImportError naming both versions",
-               isinstance(error, ImportError) and other in message and pinned in message)
+        expect(
+            f"{other} is refused with an ImportError naming both versions",
+            isinstance(error, ImportError) and other in message and pinned in message,
+        )
 
 # The check at import: a fresh YADE whose version reads as another one.
-script = ("import sys, yade.config\nyade.config.version = '2099.01z'\n"
-          "try:\n    import pfv\nexcept ImportError as error:\n    print('REFUSED', error)\n    sys.exit(0)\n"
-          "print('IMPORTED')\nsys.exit(1)\n")
+script = (
+    "import sys, yade.config\nyade.config.version = '2099.01z'\n"
+    "try:\n    import pfv\nexcept ImportError as error:\n    print('REFUSED', error)\n    sys.exit(0)\n"
+    "print('IMPORTED')\nsys.exit(1)\n"
+)
 with tempfile.TemporaryDirectory() as folder:
     path = os.path.join(folder, "other_yade.py")
     with open(path, "w") as f:
@@ -53,8 +57,10 @@ with tempfile.TemporaryDirectory() as folder:
     out = subprocess.run(["yade-double", "-n", "-x", path], cwd=folder, capture_output=True, text=True)
 refused = [line for line in out.stdout.splitlines() if line.startswith("REFUSED")]
 print(out.stdout[-600:], out.stderr[-600:])
-expect("import pfv under YADE 2099.01z raises ImportError naming both versions",
-       out.returncode == 0 and bool(refused) and "2099.01z" in refused[0] and pinned in refused[0])
+expect(
+    "import pfv under YADE 2099.01z raises ImportError naming both versions",
+    out.returncode == 0 and bool(refused) and "2099.01z" in refused[0] and pinned in refused[0],
+)
 
 print("FAILED:", failures if failures else "none")
 sys.exit(1 if failures else 0)

@@ -38,25 +38,39 @@ def check(what, ok, detail=""):
 
 
 code, yade_engine = run()
-check("YADE's own engine passes its own check", code == 0 and "OK: DEM-PFV-check.py finished" in yade_engine,
-      f"(exit {code})")
+check(
+    "YADE's own engine passes its own check",
+    code == 0 and "OK: DEM-PFV-check.py finished" in yade_engine,
+    f"(exit {code})",
+)
 code, plain = run("--pfv")
-check("engine swapped: passes YADE's own tolerances", code == 0 and "OK: DEM-PFV-check.py finished" in plain,
-      f"(exit {code})")
+check(
+    "engine swapped: passes YADE's own tolerances",
+    code == 0 and "OK: DEM-PFV-check.py finished" in plain,
+    f"(exit {code})",
+)
 code, thesis = run("--pfv", "--thesis-wall-throats")
-check("thesis' wall formula: the script runs to its checks and stops there", "YadeCheckError" in thesis
-      and "Traceback" in thesis and "DEM-PFV: unbalanced" not in thesis, f"(exit {code})")
+check(
+    "thesis' wall formula: the script runs to its checks and stops there",
+    "YadeCheckError" in thesis and "Traceback" in thesis and "DEM-PFV: unbalanced" not in thesis,
+    f"(exit {code})",
+)
 target = 0.040399916554  # the script's own reference, YADE's engine
 k_thesis = permeability(thesis)
 k_plain = permeability(plain) or target  # printed only when more than 1 % off
 k_yade = permeability(yade_engine) or target
 # The script's packing comes from its own DEM compaction, which this build of YADE does not reproduce
 # bit for bit: its target is 9 % below YADE's engine here, so PFV is compared with the engine itself.
-check("by default PFV's permeability is YADE's engine's on the same packing (1 %)",
-      abs(k_plain / k_yade - 1) < 0.01, f"(k = {k_plain} vs {k_yade})")
-check("the thesis' wall formula raises the permeability by the size of the wall term",
-      k_thesis is not None and 1.15 < k_thesis / k_plain < 1.45,
-      f"(k = {k_thesis} vs {k_plain} by default, target {target})")
+check(
+    "by default PFV's permeability is YADE's engine's on the same packing (1 %)",
+    abs(k_plain / k_yade - 1) < 0.01,
+    f"(k = {k_plain} vs {k_yade})",
+)
+check(
+    "the thesis' wall formula raises the permeability by the size of the wall term",
+    k_thesis is not None and 1.15 < k_thesis / k_plain < 1.45,
+    f"(k = {k_thesis} vs {k_plain} by default, target {target})",
+)
 for name, text in (("default", plain), ("thesis formula", thesis)):
     check(f"forceMetis gives a METIS ordering ({name})", "Metis is not used" not in text)
 

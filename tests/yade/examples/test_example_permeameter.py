@@ -57,8 +57,15 @@ def parse(text):
             packing = dict(n=int(m.group(1)), d=float(m.group(2)), L=float(m.group(3)))
         m = FLUX_RE.match(line)
         if m:
-            runs.append(dict(dp=float(m.group(1)), q_in=float(m.group(2)), q_out=float(m.group(3)),
-                             K=float(m.group(4)), slices=[]))
+            runs.append(
+                dict(
+                    dp=float(m.group(1)),
+                    q_in=float(m.group(2)),
+                    q_out=float(m.group(3)),
+                    K=float(m.group(4)),
+                    slices=[],
+                )
+            )
         m = SLICE_RE.match(line)
         if m and runs:
             runs[-1]['slices'].append((float(m.group(1)), float(m.group(2))))
@@ -84,20 +91,28 @@ def main():
     print('packing: %d spheres, d / L = %.4f' % (packing['n'], d_over_l))
     for r in runs:
         imbalance = abs(r['q_in'] + r['q_out']) / abs(r['q_in']) if r['q_in'] else math.inf
-        check(imbalance <= TOL_CONSERVATION, 'dP = %g: |Q_in + Q_out| / |Q_in| = %.3e (allowed %g)'
-              % (r['dp'], imbalance, TOL_CONSERVATION))
+        check(
+            imbalance <= TOL_CONSERVATION,
+            'dP = %g: |Q_in + Q_out| / |Q_in| = %.3e (allowed %g)' % (r['dp'], imbalance, TOL_CONSERVATION),
+        )
         check(r['q_in'] < 0 < r['q_out'], 'dP = %g: Q_in = %.6e < 0 < Q_out = %.6e' % (r['dp'], r['q_in'], r['q_out']))
         check(math.isfinite(r['K']) and r['K'] > 0, 'dP = %g: K = %.6e m2 positive and finite' % (r['dp'], r['K']))
         for y, p in r['slices']:
             error = abs(p - r['dp'] * (1 - y)) / r['dp']
-            check(error <= d_over_l, 'dP = %g: |p(y/L = %.2f) - linear| / dP = %.4f (allowed d/L = %.4f)'
-                  % (r['dp'], y, error, d_over_l))
+            check(
+                error <= d_over_l,
+                'dP = %g: |p(y/L = %.2f) - linear| / dP = %.4f (allowed d/L = %.4f)' % (r['dp'], y, error, d_over_l),
+            )
     first, second = runs
-    check(abs(second['dp'] / first['dp'] - 2) == 0, 'second pressure drop is twice the first (%g, %g)'
-          % (first['dp'], second['dp']))
+    check(
+        abs(second['dp'] / first['dp'] - 2) == 0,
+        'second pressure drop is twice the first (%g, %g)' % (first['dp'], second['dp']),
+    )
     linearity = abs(second['q_in'] / (2 * first['q_in']) - 1) if first['q_in'] else math.inf
-    check(linearity <= TOL_LINEARITY, 'Darcy: |Q_in(2 dP) / (2 Q_in(dP)) - 1| = %.3e (allowed %g)'
-          % (linearity, TOL_LINEARITY))
+    check(
+        linearity <= TOL_LINEARITY,
+        'Darcy: |Q_in(2 dP) / (2 Q_in(dP)) - 1| = %.3e (allowed %g)' % (linearity, TOL_LINEARITY),
+    )
     k_change = abs(second['K'] / first['K'] - 1) if first['K'] else math.inf
     check(k_change <= 1e-6, 'K(2 dP) / K(dP) - 1 = %.1e (K is printed to 7 digits: allowed 1e-6)' % k_change)
     for ok, message in checks:

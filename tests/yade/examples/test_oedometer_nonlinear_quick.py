@@ -26,9 +26,13 @@ THRESHOLDS = [
 
 
 def compaction(s):
-    return [(s['K_final'] < 0.9 * s['K'] and s['Cv_final'] < s['Cv'],
-             'the sample compacts: K %.4g -> %.4g m/s, C_v %.4g -> %.4g m2/s' % (s['K'], s['K_final'], s['Cv'],
-                                                                                 s['Cv_final']))]
+    return [
+        (
+            s['K_final'] < 0.9 * s['K'] and s['Cv_final'] < s['Cv'],
+            'the sample compacts: K %.4g -> %.4g m/s, C_v %.4g -> %.4g m2/s'
+            % (s['K'], s['K_final'], s['Cv'], s['Cv_final']),
+        )
+    ]
 
 
 sys.exit(run_and_check(['--quick', '--nonlinear', '--engine=pfv'], THRESHOLDS, compaction))

@@ -25,8 +25,12 @@ THRESHOLDS = [
     ('RMS isochrone pressure error / load', 'isochrone_rms_error', 0.0, 0.075),
     ('RMS mid-height pressure error / load', 'mid_pressure_rms_error', 0.0, 0.09),
     # the window's peak: the whole record's includes the servo's overshoot at loading, 2.6 x the load in both engines
-    ('peak mid-height excess pressure / load in the error window (the fluid takes the load)',
-     'max_p_mid_over_load_window', 0.85, 1.5),
+    (
+        'peak mid-height excess pressure / load in the error window (the fluid takes the load)',
+        'max_p_mid_over_load_window',
+        0.85,
+        1.5,
+    ),
     ('U at the end (T_v = 1, Terzaghi 0.931)', 'final_U', 0.90, 0.99),
     ('max |total vertical stress on the bottom - applied| / load', 'bottom_total_stress_max_error', 0.0, 0.10),
     ('max |U_sim - U_theory| with a drained layer of one radius', 'U_max_abs_error_layer', 0.0, 0.04),

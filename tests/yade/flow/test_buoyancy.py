@@ -45,8 +45,11 @@ rb.check("total: the weight of the displaced fluid", abs(total - 1) < 1e-9, f"(r
 top = O.bodies[3].state.pos[1]
 for y in (0.1, 0.5, 0.9):
     p = flow.absolute_pressure((0.5, y, 0.5))
-    rb.check(f"absolute pressure hydrostatic at y = {y}", abs(p - RHO_F * 9.81 * (top - y)) < 1e-9 * RHO_F * 9.81,
-             f"({p:.6f} vs {RHO_F * 9.81 * (top - y):.6f})")
+    rb.check(
+        f"absolute pressure hydrostatic at y = {y}",
+        abs(p - RHO_F * 9.81 * (top - y)) < 1e-9 * RHO_F * 9.81,
+        f"({p:.6f} vs {RHO_F * 9.81 * (top - y):.6f})",
+    )
 rb.check("the excess pressure stays zero", abs(flow.getPorePressure((0.5, 0.5, 0.5))) < 1e-12)
 
 # One sphere free to move among frozen ones: neutral, then twice as dense as the fluid.
@@ -54,14 +57,17 @@ for density, expected_acc in ((RHO_F, 0.0), (2 * RHO_F, -9.81 / 2)):
     flow = still(fluid_density=RHO_F)
     ball = O.bodies[500]
     ball.state.blockedDOFs = ""
-    ball.state.mass = density * 4 / 3 * math.pi * ball.shape.radius ** 3
+    ball.state.mass = density * 4 / 3 * math.pi * ball.shape.radius**3
     for i in O.interactions.withBody(500) if hasattr(O.interactions, "withBody") else []:
         O.interactions.erase(i.id1, i.id2)
     O.engines = [e for e in O.engines if type(e).__name__ != "InteractionLoop"]  # no contacts: fluid and gravity only
     rb.run(1)
     acc = ball.state.vel[1] / O.dt
-    rb.check(f"sphere of density {density:g}: first-step acceleration {expected_acc:g}",
-             abs(acc - expected_acc) < 1e-6 * 9.81, f"({acc:.9f})")
+    rb.check(
+        f"sphere of density {density:g}: first-step acceleration {expected_acc:g}",
+        abs(acc - expected_acc) < 1e-6 * 9.81,
+        f"({acc:.9f})",
+    )
 
 flow = still(fluid_density=0.0)
 rb.run(1)

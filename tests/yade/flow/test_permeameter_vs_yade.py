@@ -31,9 +31,9 @@ def _here():
 
 HERE = _here()
 
-DP = 1.0            # applied pressure drop
+DP = 1.0  # applied pressure drop
 VISCOSITY = 1.0
-TOL_FLUX = 0.05     # relative to YADE's flux
+TOL_FLUX = 0.05  # relative to YADE's flux
 # No-slip lateral walls: there both engines follow thesis eqs 3.4-3.5. With slip walls (YADE's default)
 # YADE also multiplies R_h of wall throats by 2^(-n/4), which the thesis does not have and which lowers
 # its flux by ~15 % on this scene (doc/yade.md); that case is not a like-for-like comparison.
@@ -57,6 +57,7 @@ def run_engine(make_flow, axis, steps, label):
     import numpy as np
     from pfv_testing import scenes
     from yade import O
+
     d = scenes.build_permeameter()
     flow = make_flow()
     flow.label = 'flow'
@@ -95,15 +96,22 @@ def run_engine(make_flow, axis, steps, label):
 
 def print_half(r):
     import numpy as np
+
     print('--- %s (%s), packing %s' % (r['label'], r['engine'], r['digest']))
     print('  nCells %d   first step %.3f s   next steps %.4f s/step' % (r['nCells'], r['t_first'], r['t_next']))
-    print('  Qin %.9e  Qout %.9e  |Qin+Qout|/|Qin| %.2e'
-          % (r['Qin'], r['Qout'], abs(r['Qin'] + r['Qout']) / abs(r['Qin'])))
+    print(
+        '  Qin %.9e  Qout %.9e  |Qin+Qout|/|Qin| %.2e'
+        % (r['Qin'], r['Qout'], abs(r['Qin'] + r['Qout']) / abs(r['Qin']))
+    )
     print('  getBoundaryFlux(0..5) ' + ' '.join('%.3e' % q for q in r['Qall']))
-    print('  averagePressure %.6f   probe p min/mean/max %.4f %.4f %.4f'
-          % (r['averagePressure'], r['p'].min(), r['p'].mean(), r['p'].max()))
-    print('  sum fluidForce spheres %s   walls %s'
-          % (np.array2string(r['Fs_total'], precision=6), np.array2string(r['Fw_total'], precision=6)))
+    print(
+        '  averagePressure %.6f   probe p min/mean/max %.4f %.4f %.4f'
+        % (r['averagePressure'], r['p'].min(), r['p'].mean(), r['p'].max())
+    )
+    print(
+        '  sum fluidForce spheres %s   walls %s'
+        % (np.array2string(r['Fs_total'], precision=6), np.array2string(r['Fw_total'], precision=6))
+    )
     for k in range(6):
         print('  fluidForce wall %d %s' % (k, np.array2string(r['Fw'][k], precision=6)))
 
@@ -111,6 +119,7 @@ def print_half(r):
 def compare(y, p):
     """Return list of (name, value, limit, ok) rows."""
     import numpy as np
+
     rows = []
 
     def row(name, value, limit):
@@ -119,22 +128,37 @@ def compare(y, p):
     row('identical packing (0 = yes)', 0.0 if y['digest'] == p['digest'] else 1.0, 0.0)
     row('Qin  rel. diff', abs(p['Qin'] - y['Qin']) / abs(y['Qin']), TOL_FLUX)
     row('Qout rel. diff', abs(p['Qout'] - y['Qout']) / abs(y['Qout']), TOL_FLUX)
-    row('pfv |Qin+Qout|/|Qin|', abs(p['Qin'] + p['Qout']) / abs(p['Qin']) if p['Qin'] else float('inf'),
-        TOL_CONSERVATION)
+    row(
+        'pfv |Qin+Qout|/|Qin|',
+        abs(p['Qin'] + p['Qout']) / abs(p['Qin']) if p['Qin'] else float('inf'),
+        TOL_CONSERVATION,
+    )
     row('probe |dp|max / DP', np.abs(p['p'] - y['p']).max() / DP, TOL_PRESSURE)
     fy, fp = y['Fs'], p['Fs']
     ny = np.linalg.norm(fy, axis=1)
     rel = np.linalg.norm(fp - fy, axis=1) / np.maximum(ny, 1e-12 * ny.max())
     row('sphere force median rel. diff', np.median(rel), TOL_FORCE_MEDIAN)
     rows.append(('  (info) sphere force p90 rel. diff', float(np.percentile(rel, 90)), float('nan'), True))
-    rows.append(('  (info) sphere force max |dF|/mean|F|', float(np.linalg.norm(fp - fy, axis=1).max() / ny.mean()),
-                 float('nan'), True))
-    row('total force spheres rel. diff', np.linalg.norm(p['Fs_total'] - y['Fs_total']) / np.linalg.norm(y['Fs_total']),
-        TOL_TOTAL)
+    rows.append(
+        (
+            '  (info) sphere force max |dF|/mean|F|',
+            float(np.linalg.norm(fp - fy, axis=1).max() / ny.mean()),
+            float('nan'),
+            True,
+        )
+    )
+    row(
+        'total force spheres rel. diff',
+        np.linalg.norm(p['Fs_total'] - y['Fs_total']) / np.linalg.norm(y['Fs_total']),
+        TOL_TOTAL,
+    )
     scale = DP * y['area']
     row('wall forces max |dF| / (DP*A)', np.linalg.norm(p['Fw'] - y['Fw'], axis=1).max() / scale, TOL_TOTAL)
-    row('total spheres+walls |dF| / (DP*A)',
-        np.linalg.norm((p['Fs_total'] + p['Fw_total']) - (y['Fs_total'] + y['Fw_total'])) / scale, TOL_TOTAL)
+    row(
+        'total spheres+walls |dF| / (DP*A)',
+        np.linalg.norm((p['Fs_total'] + p['Fw_total']) - (y['Fs_total'] + y['Fw_total'])) / scale,
+        TOL_TOTAL,
+    )
     return rows
 
 
@@ -146,6 +170,7 @@ def dump_json(path, halves):
         if isinstance(v, np.ndarray):
             return v.tolist()
         return v
+
     with open(path, 'w') as f:
         json.dump([{k: conv(v) for k, v in h.items()} for h in halves], f, indent=1)
 
@@ -154,11 +179,14 @@ def main(argv):
     import traceback
     from yade import O
     from yade.wrapper import FlowEngine as YadeFlow
+
     axis = _opt(argv, 'axis', 1)
     steps = max(_opt(argv, 'steps', 2), 1)
     jsonPath = _opt(argv, 'json', '')
-    print('permeameter: axis %d, dp %g, viscosity %g, %d steps, yade threads %d'
-          % (axis, DP, VISCOSITY, steps, O.numThreads))
+    print(
+        'permeameter: axis %d, dp %g, viscosity %g, %d steps, yade threads %d'
+        % (axis, DP, VISCOSITY, steps, O.numThreads)
+    )
 
     y = run_engine(YadeFlow, axis, steps, 'YADE FlowEngine')
     print_half(y)
@@ -174,13 +202,16 @@ def main(argv):
         else:
             from pfv import FlowEngine as PfvFlow
     except Exception as e:
-        print('PFV_IMPORT_FAILED: cannot import pfv.FlowEngine (%s: %s). Build and install the pfv package '
-              '(its directory must be on PYTHONPATH or in /usr/local/lib/python3.11/dist-packages).'
-              % (type(e).__name__, e))
+        print(
+            'PFV_IMPORT_FAILED: cannot import pfv.FlowEngine (%s: %s). Build and install the pfv package '
+            '(its directory must be on PYTHONPATH or in /usr/local/lib/python3.11/dist-packages).'
+            % (type(e).__name__, e)
+        )
         return 1
     try:
-        p = run_engine(PfvFlow, axis, steps,
-                       'YADE FlowEngine (self-check)' if PfvFlow is YadeFlow else 'pfv FlowEngine')
+        p = run_engine(
+            PfvFlow, axis, steps, 'YADE FlowEngine (self-check)' if PfvFlow is YadeFlow else 'pfv FlowEngine'
+        )
     except Exception:
         traceback.print_exc()
         print('FAIL: the pfv half raised an exception')
@@ -192,8 +223,15 @@ def main(argv):
     rows = compare(y, p)
     print('\n%-42s %12s %12s  %s' % ('check', 'value', 'limit', 'result'))
     for name, value, limit, ok in rows:
-        print('%-42s %12.4e %12s  %s' % (name, value, '' if limit != limit else '%.1e' % limit,
-                                         '' if limit != limit else ('ok' if ok else 'FAIL')))
+        print(
+            '%-42s %12.4e %12s  %s'
+            % (
+                name,
+                value,
+                '' if limit != limit else '%.1e' % limit,
+                '' if limit != limit else ('ok' if ok else 'FAIL'),
+            )
+        )
     print('\n%-8s %14s %14s' % ('probe', 'p YADE', 'p pfv'))
     for k in (0, 4, 13, 22, 26):
         print('%-8d %14.6f %14.6f' % (k, y['p'][k], p['p'][k]))
@@ -207,11 +245,16 @@ def test_permeameter_vs_yade():
     import shutil
     import subprocess
     import pytest
+
     exe = shutil.which('yade-double')
     if exe is None:
         pytest.skip('yade-double not installed')
-    r = subprocess.run([exe, '-n', '-x', os.path.join(HERE, 'test_permeameter_vs_yade.py')],
-                       capture_output=True, text=True, timeout=900)
+    r = subprocess.run(
+        [exe, '-n', '-x', os.path.join(HERE, 'test_permeameter_vs_yade.py')],
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     print(r.stdout[-6000:])
     assert r.returncode == 0, 'yade-double exited with %d\n%s\n%s' % (r.returncode, r.stdout[-4000:], r.stderr[-2000:])
 

@@ -66,16 +66,22 @@ pos_off = positions(ids_off)
 O.run(1, True)
 fluid_off = [flow_off.fluidForce(i) for i in ids_off]
 total_off = [Vector3(O.forces.f(i)) for i in ids_off]
-check(max((a - b).norm() for a, b in zip(pos_on, pos_off)) == 0.0,
-      "identical positions after the first step (no velocity yet: no shear)")
+check(
+    max((a - b).norm() for a, b in zip(pos_on, pos_off)) == 0.0,
+    "identical positions after the first step (no velocity yet: no shear)",
+)
 scale = max(f.norm() for f in fluid_off)
 shear_scale = max(f.norm() for f in shear_on)
 print(f"     largest fluid force {scale:.4g} N, largest shear force {shear_scale:.4g} N (mu = 1 Pa.s)")
 check(shear_scale > 0, "the shear force is not zero")
-check(max((a - s - b).norm() for a, s, b in zip(fluid_on, shear_on, fluid_off)) <= 1e-9 * scale,
-      "fluidForce includes shearLubForce")
-check(max((a - s - b).norm() for a, s, b in zip(total_on, shear_on, total_off)) <= 1e-9 * scale,
-      "the shear force reaches O.forces")
+check(
+    max((a - s - b).norm() for a, s, b in zip(fluid_on, shear_on, fluid_off)) <= 1e-9 * scale,
+    "fluidForce includes shearLubForce",
+)
+check(
+    max((a - s - b).norm() for a, s, b in zip(total_on, shear_on, total_off)) <= 1e-9 * scale,
+    "the shear force reaches O.forces",
+)
 total = sum(shear_on, Vector3.Zero) + sum(walls_on, Vector3.Zero)
 check(total.norm() <= 1e-12 * sum(f.norm() for f in shear_on), f"shear forces sum to zero ({total.norm():.2e})")
 lower = sum(s[0] for s, p in zip(shear_on, pos_on) if p[1] < 0.5)

@@ -50,7 +50,8 @@ def run(engine_class):
         pos=np.array([tuple(O.bodies[i].state.pos) for i in ids]),
         vel=np.array([tuple(O.bodies[i].state.vel) for i in ids]),
         ang=np.array([tuple(O.bodies[i].state.angVel) for i in ids]),
-        rad=np.array([O.bodies[i].shape.radius for i in ids]))
+        rad=np.array([O.bodies[i].shape.radius for i in ids]),
+    )
     O.run(1, True)
     state['force'] = np.array([tuple(flow.shearLubForce(i)) for i in ids])
     if engine_class is pfv.FlowEngine:
@@ -108,11 +109,14 @@ def main():
     # YADE's run started from the same state; its pairs are PFV's (same regular triangulation of the same packing).
     as_yade = recompute(pfv_run['pairs'], yade_run, yade_definition=True)
     ratio_y, cosine_y, residual_y = compare(yade_run['force'], as_yade)
-    print('2. YADE definition on PFV pairs vs YADE: ratio %.5f, cosine %.7f, relative difference %.2e'
-          % (ratio_y, cosine_y, residual_y))
+    print(
+        '2. YADE definition on PFV pairs vs YADE: ratio %.5f, cosine %.7f, relative difference %.2e'
+        % (ratio_y, cosine_y, residual_y)
+    )
     if not (residual_y < 1e-3 and cosine_y > 0.99999):
-        failures.append('YADE forces not reproduced by R_h = gap + 0.45 r_min (residual %.2e, cosine %.7f)'
-                        % (residual_y, cosine_y))
+        failures.append(
+            'YADE forces not reproduced by R_h = gap + 0.45 r_min (residual %.2e, cosine %.7f)' % (residual_y, cosine_y)
+        )
 
     pfv_rh = recompute(pfv_run['pairs'], yade_run, yade_definition=False)
     ratio_p, _, _ = compare(yade_run['force'], pfv_rh)

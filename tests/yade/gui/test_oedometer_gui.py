@@ -46,12 +46,20 @@ def main():
     cmd = [xvfb, '-a', '-s', '-screen 0 1600x1200x24', yade, '-j1', '-x', DRIVER, os.path.join(out, 'gui')] + ARGS
     print('running: ' + ' '.join(cmd), flush=True)
     try:
-        proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                              text=True, env=env, timeout=600)
+        proc = subprocess.run(
+            cmd,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            env=env,
+            timeout=600,
+        )
         code, text = proc.returncode, proc.stdout
     except subprocess.TimeoutExpired as e:
-        code, text = 'timeout', ((e.stdout or b'').decode(errors='replace') if isinstance(e.stdout, bytes)
-                                 else (e.stdout or ''))
+        code, text = 'timeout', (
+            (e.stdout or b'').decode(errors='replace') if isinstance(e.stdout, bytes) else (e.stdout or '')
+        )
     print('\n'.join(line for line in text.splitlines() if line.startswith(('oedometer:', 'gui driver:'))))
     check(code == 0, 'GUI run completed (exit %s)' % code)
     gui_json = os.path.join(out, 'gui', 'gui.json')
@@ -62,24 +70,41 @@ def main():
         return 1
     with open(gui_json) as f:
         g = json.load(f)
-    check(g['status'] == 'ok' and g['hasDisplay'], 'the example ran in GUI mode (status %s, display %s)'
-          % (g['status'], g['hasDisplay']))
+    check(
+        g['status'] == 'ok' and g['hasDisplay'],
+        'the example ran in GUI mode (status %s, display %s)' % (g['status'], g['hasDisplay']),
+    )
     running = [t for t in g['ticks'] if t['running']]
     seen = set(w.split(':')[0] for t in running for w in t['windows'])
-    check({'ControllerClass', 'QOpenGLWidget', 'MainWindow'} <= seen
-          and max((t['views'] for t in running), default=0) >= 1,
-          "controller, 3D view and live figure on screen during the run (%s)" % sorted(seen))
+    check(
+        {'ControllerClass', 'QOpenGLWidget', 'MainWindow'} <= seen
+        and max((t['views'] for t in running), default=0) >= 1,
+        "controller, 3D view and live figure on screen during the run (%s)" % sorted(seen),
+    )
     iters = [t['iter'] for t in running]
     points = [t['points'] for t in running]
-    check(len(running) >= 3 and iters[-1] > iters[0] and points[-1] > points[0],
-          'GUI live during the run: %d half-second ticks while running, iterations %s .. %s, plot points %s .. %s'
-          % (len(running), iters[0] if iters else '-', iters[-1] if iters else '-', points[0] if points else '-',
-             points[-1] if points else '-'))
+    check(
+        len(running) >= 3 and iters[-1] > iters[0] and points[-1] > points[0],
+        'GUI live during the run: %d half-second ticks while running, iterations %s .. %s, plot points %s .. %s'
+        % (
+            len(running),
+            iters[0] if iters else '-',
+            iters[-1] if iters else '-',
+            points[0] if points else '-',
+            points[-1] if points else '-',
+        ),
+    )
     check(os.path.exists(os.path.join(out, 'gui', 'screen.png')), 'screenshot taken')
 
     head = os.path.join(out, 'headless')
-    proc = subprocess.run([yade, '-j1', '-n', '-x', EXAMPLE, '--out=' + head] + ARGS, stdin=subprocess.DEVNULL,
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    proc = subprocess.run(
+        [yade, '-j1', '-n', '-x', EXAMPLE, '--out=' + head] + ARGS,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        timeout=600,
+    )
     check(proc.returncode == 0, 'headless run completed (exit %d)' % proc.returncode)
     if proc.returncode == 0:
         with open(summary_path) as f:
@@ -87,8 +112,11 @@ def main():
         with open(os.path.join(head, 'summary.json')) as f:
             b = json.load(f)
         diff = [k for k in KEYS if a[k] != b[k]]
-        check(not diff, 'GUI and headless runs give the same results (%s; differ: %s)'
-              % (', '.join('%s %.6g' % (k, a[k]) for k in KEYS), diff or 'none'))
+        check(
+            not diff,
+            'GUI and headless runs give the same results (%s; differ: %s)'
+            % (', '.join('%s %.6g' % (k, a[k]) for k in KEYS), diff or 'none'),
+        )
     print('%d failed; outputs in %s' % (len(failures), out))
     if not failures:
         shutil.rmtree(out, ignore_errors=True)

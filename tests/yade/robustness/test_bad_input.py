@@ -13,8 +13,12 @@ from pfv import FlowEngine  # noqa: E402
 flow = fresh()
 expect_error("unknown attribute", AttributeError, "viscosityy", lambda: setattr(flow, "viscosityy", 1.0))
 expect_error("unknown constructor keyword", AttributeError, "pressureeForce", lambda: FlowEngine(pressureeForce=True))
-expect_error("YADE attribute not supported", NotImplementedError, "normalLubrication",
-             lambda: setattr(flow, "normalLubrication", True))
+expect_error(
+    "YADE attribute not supported",
+    NotImplementedError,
+    "normalLubrication",
+    lambda: setattr(flow, "normalLubrication", True),
+)
 flow.normalLubrication = False  # YADE's default is accepted
 expect_error("YADE method out of scope", NotImplementedError, "getCavityFlux", lambda: flow.getCavityFlux())
 expect_error("non-positive viscosity", ValueError, "viscosity", lambda: setattr(flow, "viscosity", -1.0))
@@ -62,10 +66,14 @@ flow.boundaryUseMaxMin = use_max_min
 
 # The scene is still usable and gives the same answer as before the failures.
 run_step()
-if (abs(flow.getBoundaryFlux(2) - q_ref) > 1e-12 * abs(q_ref)
-        or abs(flow.getPorePressure((0.5, 0.5, 0.5)) - p_ref) > 1e-12):
-    fail(f"results changed after recovering from bad input: Qin {flow.getBoundaryFlux(2)} vs {q_ref}, "
-         f"p {flow.getPorePressure((0.5, 0.5, 0.5))} vs {p_ref}")
+if (
+    abs(flow.getBoundaryFlux(2) - q_ref) > 1e-12 * abs(q_ref)
+    or abs(flow.getPorePressure((0.5, 0.5, 0.5)) - p_ref) > 1e-12
+):
+    fail(
+        f"results changed after recovering from bad input: Qin {flow.getBoundaryFlux(2)} vs {q_ref}, "
+        f"p {flow.getPorePressure((0.5, 0.5, 0.5))} vs {p_ref}"
+    )
 else:
     print("ok   scene usable after failures, results unchanged")
 

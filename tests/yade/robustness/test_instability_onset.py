@@ -41,8 +41,10 @@ just_below[amplitude >= 300] = 0.999 * V_REF
 just_below[amplitude >= 310] = 1.001 * V_REF
 onset = diagnostics.instability_onset(amplitude, energy(just_below), MASS, D50, F, G)
 rb.check("the threshold is sharp: 0.999 of it is rest, 1.001 motion", onset == 310.0, f"(got {onset})")
-rb.check("a looser threshold fires at the first excursion",
-         diagnostics.instability_onset(amplitude, energy(just_below), MASS, D50, 0.5 * F, G) == 300.0)
+rb.check(
+    "a looser threshold fires at the first excursion",
+    diagnostics.instability_onset(amplitude, energy(just_below), MASS, D50, 0.5 * F, G) == 300.0,
+)
 
 never_rests = np.full(amplitude.shape, 2 * V_REF)
 
@@ -54,16 +56,33 @@ def onset_of(v):
 rb.check("never at rest: NaN", math.isnan(onset_of(never_rests)))
 rb.check("never moves again: NaN", math.isnan(onset_of(at_rest)))
 
-expect_error("records of two lengths", ValueError, "one length",
-             lambda: diagnostics.instability_onset(amplitude[:-1], energy(fails), MASS, D50, F))
-expect_error("a negative kinetic energy", ValueError, "non-negative",
-             lambda: diagnostics.instability_onset(amplitude, -energy(fails), MASS, D50, F))
+expect_error(
+    "records of two lengths",
+    ValueError,
+    "one length",
+    lambda: diagnostics.instability_onset(amplitude[:-1], energy(fails), MASS, D50, F),
+)
+expect_error(
+    "a negative kinetic energy",
+    ValueError,
+    "non-negative",
+    lambda: diagnostics.instability_onset(amplitude, -energy(fails), MASS, D50, F),
+)
 nan_record = energy(fails)
 nan_record[7] = float("nan")
-expect_error("a NaN in the record", ValueError, "finite",
-             lambda: diagnostics.instability_onset(amplitude, nan_record, MASS, D50, F))
-expect_error("a zero mass", ValueError, "mass",
-             lambda: diagnostics.instability_onset(amplitude, energy(fails), 0.0, D50, F))
-expect_error("a negative threshold", ValueError, "threshold",
-             lambda: diagnostics.instability_onset(amplitude, energy(fails), MASS, D50, -F))
+expect_error(
+    "a NaN in the record",
+    ValueError,
+    "finite",
+    lambda: diagnostics.instability_onset(amplitude, nan_record, MASS, D50, F),
+)
+expect_error(
+    "a zero mass", ValueError, "mass", lambda: diagnostics.instability_onset(amplitude, energy(fails), 0.0, D50, F)
+)
+expect_error(
+    "a negative threshold",
+    ValueError,
+    "threshold",
+    lambda: diagnostics.instability_onset(amplitude, energy(fails), MASS, D50, -F),
+)
 rb.report("instability onset")

@@ -79,8 +79,9 @@ for change in SCENE_CHANGES:
             if not ok:
                 rb.fail(f"{change.__name__} then {name} = {value!r}: fluxes not conserved {figures}")
         except Exception as error:  # noqa: BLE001
-            rb.fail(f"{change.__name__} then {name} = {value!r}: {type(error).__name__}: "
-                    f"{str(error).splitlines()[-1]}")
+            rb.fail(
+                f"{change.__name__} then {name} = {value!r}: {type(error).__name__}: " f"{str(error).splitlines()[-1]}"
+            )
         combinations += 1
 rb.check("scene changes x setting changes run on", not rb.failures, f"({combinations} sequences)")
 
@@ -92,8 +93,11 @@ for solver in (3, 1, 0):
     flow.viscosity = 2.0
     rb.run(1)
     ratio = flow.getBoundaryFlux(2) / q0
-    rb.check(f"useSolver={solver}: doubled viscosity halves the flux at once", abs(ratio - 0.5) < 1e-6,
-             f"(ratio {ratio:.9f})")
+    rb.check(
+        f"useSolver={solver}: doubled viscosity halves the flux at once",
+        abs(ratio - 0.5) < 1e-6,
+        f"(ratio {ratio:.9f})",
+    )
     rb.check(f"useSolver={solver}: no remesh for a viscosity change", flow.core.remesh_count == meshes)
 
 rb.report("edit-sequence")

@@ -43,8 +43,11 @@ while O.running or queries == 0:
     except Exception as error:  # noqa: BLE001
         errors.append(f"{type(error).__name__}: {error}")
 O.wait()
-rb.check("queries during O.run answered", not errors and queries > 10,
-         f"({queries} rounds of 6 queries, {flow.core.remesh_count} remeshes; errors: {errors[:3]})")
+rb.check(
+    "queries during O.run answered",
+    not errors and queries > 10,
+    f"({queries} rounds of 6 queries, {flow.core.remesh_count} remeshes; errors: {errors[:3]})",
+)
 p_mid = flow.getPorePressure((0.5, 0.5, 0.5))
 rb.check("pressure after the run is the linear profile's", 0.3 < p_mid < 0.7, f"(p = {p_mid:.4f})")
 
@@ -65,21 +68,28 @@ for k in range(300):
         rss_20 = resident_kb()
 gc.collect()
 holding = sum(e.core.has_mesh() for e in engines)
-rb.check("engines out of O.engines hold no mesh once another steps", holding <= 1,
-         f"({holding} of {len(engines)} hold one)")
+rb.check(
+    "engines out of O.engines hold no mesh once another steps", holding <= 1, f"({holding} of {len(engines)} hold one)"
+)
 rss_300 = resident_kb()
 # Each engine's mesh and factor take about 8 MB here (kept, 280 swaps would grow by 2 GB); the Python
 # objects YADE keeps are a few kB each.
-rb.check("memory flat over 280 engine swaps", rss_300 - rss_20 < 50 * 1024,
-         f"({(rss_300 - rss_20) / 1024:.1f} MB growth of the resident size)")
+rb.check(
+    "memory flat over 280 engine swaps",
+    rss_300 - rss_20 < 50 * 1024,
+    f"({(rss_300 - rss_20) / 1024:.1f} MB growth of the resident size)",
+)
 del engines
 
 # 3. The record of the collective limit stays bounded over a long run of remeshes.
 flow = rb.fresh(meshUpdateInterval=1)
 rb.run(HISTORY_LENGTH + 50)
 history = flow.collective_viscous_history
-rb.check("collective-limit history bounded", len(history) == HISTORY_LENGTH,
-         f"({len(history)} entries after {flow.core.remesh_count} remeshes)")
+rb.check(
+    "collective-limit history bounded",
+    len(history) == HISTORY_LENGTH,
+    f"({len(history)} entries after {flow.core.remesh_count} remeshes)",
+)
 rb.check("history holds the latest computations", history[-1]["remesh_count"] == flow.core.remesh_count)
 
 rb.report("thread and memory")

@@ -34,15 +34,25 @@ def read_array(path):
     with open(path) as f:
         lines = [line for line in f if not line.startswith("%")]
     n = int(lines[0].split()[0])
-    return np.array([float(v) for v in lines[1:1 + n]])
+    return np.array([float(v) for v in lines[1 : 1 + n]])
 
 
 def solve(folder, processes):
     out = os.path.join(folder, f"x{processes}.mtx")
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    run = subprocess.run(["mpirun", "-np", str(processes), driver(), folder, f"--out={out}"], env=env,
-                         capture_output=True, text=True, timeout=300)
+    env = dict(
+        os.environ,
+        OMPI_ALLOW_RUN_AS_ROOT="1",
+        OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+        OMP_NUM_THREADS="1",
+        OMPI_MCA_rmaps_base_oversubscribe="1",
+    )
+    run = subprocess.run(
+        ["mpirun", "-np", str(processes), driver(), folder, f"--out={out}"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     print(run.stdout.strip())
     if run.returncode != 0:
         rb.fail(f"mpirun -np {processes}: exit {run.returncode}: {run.stderr.strip()[-500:]}")

@@ -41,10 +41,16 @@ def history(steps=20, **kw):
     for _ in range(steps):
         rb.run(1)
         core = flow.core
-        out.append(dict(outflux=flow.getBoundaryFlux(3), force=tuple(O.forces.f(10)), balance=rb.conserved(flow)[1],
-                        pressure=[p for p, w in zip(core.pressure(), core.cell_sources()) if w == -1],
-                        k_outlet=boundary_conductance(core, (3,)),
-                        k_walls=boundary_conductance(core, (2, 3))))
+        out.append(
+            dict(
+                outflux=flow.getBoundaryFlux(3),
+                force=tuple(O.forces.f(10)),
+                balance=rb.conserved(flow)[1],
+                pressure=[p for p, w in zip(core.pressure(), core.cell_sources()) if w == -1],
+                k_outlet=boundary_conductance(core, (3,)),
+                k_walls=boundary_conductance(core, (2, 3)),
+            )
+        )
     return flow, out
 
 
@@ -63,20 +69,31 @@ def against_direct(name, steps, direct, tolerance):
         balance = max(balance, abs(imbalance) / (bound * a["k_walls"]))
         force = max(force, max(abs(x - y) for x, y in zip(a["force"], b["force"])) / max(abs(y) for y in b["force"]))
     worst_m = max(abs(a["balance"][1]) / a["balance"][0] for a in steps)
-    rb.check(f"{name}: pressures equal CHOLMOD's within refinement_tolerance x spread at every step", error <= 1,
-             f"worst {error:.2f} x that bound")
-    rb.check(f"{name}: outflux equals CHOLMOD's within what that bound implies", outflux <= 1,
-             f"worst {outflux:.2e} x (bound x outlet throats' conductance)")
-    rb.check(f"{name}: wall fluxes balance the volume rates within what that bound implies", balance <= 1,
-             f"worst {balance:.2e} x (bound x pressure walls' throats' conductance); {worst_m:.2e} of the largest "
-             "wall flux")
+    rb.check(
+        f"{name}: pressures equal CHOLMOD's within refinement_tolerance x spread at every step",
+        error <= 1,
+        f"worst {error:.2f} x that bound",
+    )
+    rb.check(
+        f"{name}: outflux equals CHOLMOD's within what that bound implies",
+        outflux <= 1,
+        f"worst {outflux:.2e} x (bound x outlet throats' conductance)",
+    )
+    rb.check(
+        f"{name}: wall fluxes balance the volume rates within what that bound implies",
+        balance <= 1,
+        f"worst {balance:.2e} x (bound x pressure walls' throats' conductance); {worst_m:.2e} of the largest "
+        "wall flux",
+    )
     rb.check(f"{name}: force on a sphere equals CHOLMOD's at every step (1e-7)", force < 1e-7, f"worst {force:.2e}")
 
 
 flow, direct = history(solver="cholesky", mixed_precision=False)
 rb.check("solver='cholesky': useSolver reads 3", flow.useSolver == 3)
-rb.check("the CHOLMOD run conserves mass at every step (1e-8 of the largest wall flux)",
-         all(abs(d["balance"][1]) <= 1e-8 * d["balance"][0] for d in direct))
+rb.check(
+    "the CHOLMOD run conserves mass at every step (1e-8 of the largest wall flux)",
+    all(abs(d["balance"][1]) <= 1e-8 * d["balance"][0] for d in direct),
+)
 flow, multigrid = history(solver="multigrid")
 rb.check("solver='multigrid' is built", flow.core.solver_choice.startswith("multigrid"), flow.core.solver_choice)
 rb.check("solver='multigrid': useSolver reads -1 (no YADE number)", flow.useSolver == -1)
@@ -94,42 +111,67 @@ flow = rb.fresh()
 rb.check("the default solver is 'auto'", flow.solver == "auto")
 rb.check("solver='auto' reads as useSolver 3", flow.useSolver == 3)
 rb.run(1)
-rb.check("auto picks CHOLMOD for a small packing", flow.core.solver_choice.startswith("cholesky: the factor stores"),
-         flow.core.solver_choice)
+rb.check(
+    "auto picks CHOLMOD for a small packing",
+    flow.core.solver_choice.startswith("cholesky: the factor stores"),
+    flow.core.solver_choice,
+)
 
 O.reset()
 flow = rb.fresh(max_factor_bytes=1e4)
 with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
     rb.run(2)
-rb.check("auto picks multigrid beyond max_factor_bytes",
-         flow.core.solver_choice.startswith("multigrid: the Cholesky factor would store"), flow.core.solver_choice)
+rb.check(
+    "auto picks multigrid beyond max_factor_bytes",
+    flow.core.solver_choice.startswith("multigrid: the Cholesky factor would store"),
+    flow.core.solver_choice,
+)
 said = [str(w.message) for w in caught if "solver='auto' solves by multigrid" in str(w.message)]
-rb.check("auto says once, in a warning, that it took multigrid and why",
-         len(said) == 1 and "would store" in said[0] and "more than the budget of 0.01 MB" in said[0], "; ".join(said))
+rb.check(
+    "auto says once, in a warning, that it took multigrid and why",
+    len(said) == 1 and "would store" in said[0] and "more than the budget of 0.01 MB" in said[0],
+    "; ".join(said),
+)
 q = flow.getBoundaryFlux(3)
 
 O.reset()
 flow = rb.fresh(solver="cholesky", max_factor_bytes=1e4)
-rb.expect_error("a named cholesky beyond max_factor_bytes", RuntimeError,
-                "solver='cholesky': the Cholesky factor would store", rb.run)
+rb.expect_error(
+    "a named cholesky beyond max_factor_bytes",
+    RuntimeError,
+    "solver='cholesky': the Cholesky factor would store",
+    rb.run,
+)
 flow.solver = "multigrid"
 rb.run(1)
-rb.check("after the refusal the engine runs on with another solver",
-         flow.core.solver_choice == "multigrid: as set" and abs(flow.getBoundaryFlux(3) - q) <= 1e-8 * abs(q),
-         f"{flow.core.solver_choice}; outflux {flow.getBoundaryFlux(3):.9e} against {q:.9e}")
+rb.check(
+    "after the refusal the engine runs on with another solver",
+    flow.core.solver_choice == "multigrid: as set" and abs(flow.getBoundaryFlux(3) - q) <= 1e-8 * abs(q),
+    f"{flow.core.solver_choice}; outflux {flow.getBoundaryFlux(3):.9e} against {q:.9e}",
+)
 
 O.reset()
 flow = rb.fresh()
 rb.run(1)
 rb.expect_error("unknown solver name", ValueError, "solver must be one of", lambda: setattr(flow, "solver", "amg"))
-rb.expect_error("negative max_factor_bytes", ValueError, "max_factor_bytes",
-                lambda: setattr(flow, "max_factor_bytes", -1.0))
-rb.expect_error("unknown multigrid smoother", ValueError, "multigrid_smoother must be one of",
-                lambda: setattr(flow, "multigrid_smoother", "sor"))
-rb.check("the solver is unchanged after the refused settings",
-         flow.solver == "auto" and flow.multigrid_smoother == "gauss_seidel")
+rb.expect_error(
+    "negative max_factor_bytes", ValueError, "max_factor_bytes", lambda: setattr(flow, "max_factor_bytes", -1.0)
+)
+rb.expect_error(
+    "unknown multigrid smoother",
+    ValueError,
+    "multigrid_smoother must be one of",
+    lambda: setattr(flow, "multigrid_smoother", "sor"),
+)
+rb.check(
+    "the solver is unchanged after the refused settings",
+    flow.solver == "auto" and flow.multigrid_smoother == "gauss_seidel",
+)
 rb.run(1)
-rb.check("the engine still runs after the refused settings", abs(flow.getBoundaryFlux(3) / q - 1) < 1e-8,
-         f"{flow.getBoundaryFlux(3):.6e} vs {q:.6e}")
+rb.check(
+    "the engine still runs after the refused settings",
+    abs(flow.getBoundaryFlux(3) / q - 1) < 1e-8,
+    f"{flow.getBoundaryFlux(3):.6e} vs {q:.6e}",
+)
 rb.report("multigrid solver")

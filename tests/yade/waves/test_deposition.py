@@ -33,20 +33,30 @@ import numpy as np
 
 from pfv_testing import robustness as rb
 from yade import O, plot, utils  # noqa: E402
-from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,  # noqa: E402
-                          Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                          Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator,
-                          PyRunner)
+from yade.wrapper import (
+    Bo1_Box_Aabb,
+    Bo1_Sphere_Aabb,
+    ForceResetter,
+    FrictMat,
+    Ig2_Box_Sphere_ScGeom,  # noqa: E402
+    Ig2_Sphere_Sphere_ScGeom,
+    InsertionSortCollider,
+    InteractionLoop,
+    Ip2_FrictMat_FrictMat_FrictPhys,
+    Law2_ScGeom_FrictPhys_CundallStrack,
+    NewtonIntegrator,
+    PyRunner,
+)
 from pfv import FlowEngine, diagnostics  # noqa: E402
 
 warnings.simplefilter("ignore", category=UserWarning)
 RHO_S, RHO_F, GRAVITY = 2600.0, 1000.0, 9.81
 RADIUS, N0 = 0.005, 0.61
-CELLS = (7, 20, 7)      # lattice of the cloud: x, y (vertical), z
+CELLS = (7, 20, 7)  # lattice of the cloud: x, y (vertical), z
 VISCOSITY = 0.15
 T_END = 1.8
-RECORD_EVERY = 100      # steps
-EARLY_END = 0.08        # s: the end of the collision-free settling
+RECORD_EVERY = 100  # steps
+EARLY_END = 0.08  # s: the end of the collision-free settling
 
 
 def build_cloud(seed=3):
@@ -54,8 +64,7 @@ def build_cloud(seed=3):
     spacing = RADIUS * (4.0 * math.pi / 3.0 / (1.0 - N0)) ** (1.0 / 3.0)
     box = np.array(CELLS, float) * spacing
     O.reset()
-    O.materials.append(FrictMat(young=5e6, poisson=0.5, frictionAngle=math.radians(30), density=RHO_S,
-                                label="grains"))
+    O.materials.append(FrictMat(young=5e6, poisson=0.5, frictionAngle=math.radians(30), density=RHO_S, label="grains"))
     O.materials.append(FrictMat(young=5e6, poisson=0.5, frictionAngle=0, density=0, label="walls"))
     O.bodies.append(utils.aabbWalls([(0, 0, 0), tuple(box)], thickness=0, material="walls"))
     rng = np.random.default_rng(seed)
@@ -70,19 +79,30 @@ def build_cloud(seed=3):
 
 def main():
     box = build_cloud()
-    flow = FlowEngine(label="flow", viscosity=VISCOSITY, fluid_density=RHO_F, meshUpdateInterval=50,
-                      bndCondIsPressure=[0, 0, 0, 1, 0, 0], bndCondValue=[0] * 6, boundaryUseMaxMin=[0] * 6)
+    flow = FlowEngine(
+        label="flow",
+        viscosity=VISCOSITY,
+        fluid_density=RHO_F,
+        meshUpdateInterval=50,
+        bndCondIsPressure=[0, 0, 0, 1, 0, 0],
+        bndCondValue=[0] * 6,
+        boundaryUseMaxMin=[0] * 6,
+    )
     area = box[0] * box[2]
     # Sensors over the lower half of the cloud: the bed grows through them (the clear fluid that
     # appears at the top as the cloud's surface comes down does not reach them).
     grid = diagnostics.SensorGrid.in_box((0, 0, 0), (box[0], 0.55 * box[1], box[2]), verticals=5, levels=6)
-    monitor = diagnostics.Monitor(flow, grid, N0, RHO_S, RHO_F, area, bottom=0.0, t_end=T_END, report_every=40,
-                                  g=GRAVITY)
+    monitor = diagnostics.Monitor(
+        flow, grid, N0, RHO_S, RHO_F, area, bottom=0.0, t_end=T_END, report_every=40, g=GRAVITY
+    )
     O.engines = [
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-        InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                        [Law2_ScGeom_FrictPhys_CundallStrack()]),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys()],
+            [Law2_ScGeom_FrictPhys_CundallStrack()],
+        ),
         flow,
         NewtonIntegrator(damping=0.0, gravity=(0, -GRAVITY, 0)),
         PyRunner(command="monitor(); drag()", iterPeriod=RECORD_EVERY),
@@ -90,10 +110,12 @@ def main():
     carried = []  # mean over the grains between sensors 2 and 6 of (fluid force - buoyancy) / submerged weight
 
     def drag():
-        volume = 4.0 / 3.0 * math.pi * RADIUS ** 3
+        volume = 4.0 / 3.0 * math.pi * RADIUS**3
         band = [b.id for b in O.bodies if b.id >= 6 and grid.heights[1] < b.state.pos[1] < grid.heights[5]]
-        carried.append(np.mean([flow.fluidForce(i)[1] - RHO_F * GRAVITY * volume for i in band])
-                       / ((RHO_S - RHO_F) * GRAVITY * volume))
+        carried.append(
+            np.mean([flow.fluidForce(i)[1] - RHO_F * GRAVITY * volume for i in band])
+            / ((RHO_S - RHO_F) * GRAVITY * volume)
+        )
 
     builtins.monitor, builtins.drag = monitor, drag  # PyRunner commands run in YADE's namespace
     O.dt = 0.5 * utils.PWaveTimeStep()
@@ -101,8 +123,9 @@ def main():
     O.run(int(T_END / O.dt), True)
 
     t = np.array(plot.data["t"])
-    ratio = np.array([[np.mean([plot.data[f"r_{v}_{k}"][n] for v in range(1, 6)]) for k in range(1, 6)]
-                      for n in range(len(t))])  # (records, 5 level pairs)
+    ratio = np.array(
+        [[np.mean([plot.data[f"r_{v}_{k}"][n] for v in range(1, 6)]) for k in range(1, 6)] for n in range(len(t))]
+    )  # (records, 5 level pairs)
     p_bottom = np.array([np.mean([plot.data[f"p_{v}_1"][n] for v in range(1, 6)]) for n in range(len(t))])
     gamma_prime = diagnostics.buoyant_unit_weight(N0, RHO_S, RHO_F, GRAVITY)
 
@@ -114,15 +137,24 @@ def main():
     # the cloud and contacts take part of the weight).
     early = (t > 0.02) & (t < EARLY_END)
     fluid_share = np.mean(np.array(carried)[early])
-    rb.check("suspension: the fluid carries the grains' submerged weight", abs(fluid_share - 1) < 0.03,
-             f"((fluid force - buoyancy) / submerged weight {fluid_share:.4f} over t = 0.02..{EARLY_END} s)")
+    rb.check(
+        "suspension: the fluid carries the grains' submerged weight",
+        abs(fluid_share - 1) < 0.03,
+        f"((fluid force - buoyancy) / submerged weight {fluid_share:.4f} over t = 0.02..{EARLY_END} s)",
+    )
     suspended = ratio[early][:, 1:].mean()
-    rb.check("suspension: grad H / i_c of the levels above the first is about 1 (claim 20)",
-             abs(suspended - 1) < 0.10, f"(mean {suspended:.3f} over t = 0.02..{EARLY_END} s)")
+    rb.check(
+        "suspension: grad H / i_c of the levels above the first is about 1 (claim 20)",
+        abs(suspended - 1) < 0.10,
+        f"(mean {suspended:.3f} over t = 0.02..{EARLY_END} s)",
+    )
     weight_above = gamma_prime * (np.array(plot.data["top"])[early] - grid.heights[0])  # the cloud's surface falls
     p_early = np.mean(p_bottom[early] / weight_above)
-    rb.check("suspension: the bottom sensor's excess pressure is the submerged weight above it",
-             abs(p_early - 1) < 0.10, f"(ratio {p_early:.3f})")
+    rb.check(
+        "suspension: the bottom sensor's excess pressure is the submerged weight above it",
+        abs(p_early - 1) < 0.10,
+        f"(ratio {p_early:.3f})",
+    )
 
     # Bottom-up decay: the first record at which each level pair falls below i_c / 2, after the start.
     start = np.argmax(t > 0.02)
@@ -133,13 +165,18 @@ def main():
     # Two level pairs whose smoothed gradients cross i_c / 2 within one smoothing window of each other fall
     # together as far as this signal can tell: their order is below its resolution.
     window = t[min(len(kernel), len(t) - 1)] - t[0]
-    rb.check("the gradient falls level after level from the bottom up", all(np.isfinite(drop))
-             and all(a <= b + window for a, b in zip(drop, drop[1:])) and drop[0] < drop[-1],
-             "(t_1/2 per level: " + ", ".join(f"{d:.3f}" for d in drop) + f" s; ties within the {window:.3f} s "
-             "smoothing window allowed)")
+    rb.check(
+        "the gradient falls level after level from the bottom up",
+        all(np.isfinite(drop)) and all(a <= b + window for a, b in zip(drop, drop[1:])) and drop[0] < drop[-1],
+        "(t_1/2 per level: " + ", ".join(f"{d:.3f}" for d in drop) + f" s; ties within the {window:.3f} s "
+        "smoothing window allowed)",
+    )
     final = ratio[-1]
-    rb.check("at the end the bed carries its weight: every gradient below 0.1 i_c", np.all(np.abs(final) < 0.1),
-             "(" + ", ".join(f"{r:.3f}" for r in final) + ")")
+    rb.check(
+        "at the end the bed carries its weight: every gradient below 0.1 i_c",
+        np.all(np.abs(final) < 0.1),
+        "(" + ", ".join(f"{r:.3f}" for r in final) + ")",
+    )
 
     ids, pos, rad, _, _ = diagnostics.sphere_arrays(O.bodies)
     top = diagnostics.top_height(pos, rad, 0.99)
@@ -147,12 +184,17 @@ def main():
     stresses = utils.bodyStressTensors()
     heights, sigma = diagnostics.effective_stress_profile(stresses, ids, pos, rad, 0.0, top, 6, area)
     mid = 2  # the third of six slices: away from the bottom wall and the loose surface
-    volume = 4.0 / 3.0 * math.pi * rad ** 3
+    volume = 4.0 / 3.0 * math.pi * rad**3
     carried = (RHO_S - RHO_F) * GRAVITY * volume[pos[:, 1] > heights[mid]].sum() / area
-    rb.check("the bed's effective stress at mid-depth carries the submerged weight above it",
-             abs(sigma[mid] / carried - 1) < 0.15, f"({sigma[mid]:.1f} Pa vs {carried:.1f} Pa; bed n = {n_bed:.3f})")
-    print(f"deposition: bed porosity {n_bed:.3f} (cloud {N0}), top {top:.4f} m of {box[1]:.4f} m; "
-          f"{O.iter} steps, {len(t)} records")
+    rb.check(
+        "the bed's effective stress at mid-depth carries the submerged weight above it",
+        abs(sigma[mid] / carried - 1) < 0.15,
+        f"({sigma[mid]:.1f} Pa vs {carried:.1f} Pa; bed n = {n_bed:.3f})",
+    )
+    print(
+        f"deposition: bed porosity {n_bed:.3f} (cloud {N0}), top {top:.4f} m of {box[1]:.4f} m; "
+        f"{O.iter} steps, {len(t)} records"
+    )
     for arg in sys.argv[1:]:
         if arg.startswith("--plot="):
             diagnostics.save_plots(plot.data, arg.split("=", 1)[1])

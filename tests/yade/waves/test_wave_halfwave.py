@@ -58,8 +58,12 @@ L, H, W = 2.0, 1.0, 0.5
 A = 1.0
 SIZES = tuple(int(v) for v in os.environ.get('WAVE_SIZES', '12,20').split(','))  # layers over h
 # 1.5 x PFV's measured errors (module docstring), per number of layers: head_rms, head_probe, velocity.
-TOLERANCE = {8: (0.022, 0.071, 0.077), 12: (0.018, 0.077, 0.095), 16: (0.0096, 0.058, 0.089),
-             20: (0.0080, 0.026, 0.066)}
+TOLERANCE = {
+    8: (0.022, 0.071, 0.077),
+    12: (0.018, 0.077, 0.095),
+    16: (0.0096, 0.058, 0.089),
+    20: (0.0080, 0.026, 0.066),
+}
 failures = []
 
 
@@ -175,13 +179,18 @@ def run_size(num):
         kd = conductivity(kind)
         flow = wave_engine(kind)
         measured[name] = errors(flow, kd)
-        print(f"{n} spheres, {name}: Kd = {kd:.5g}, head_rms = {measured[name][0]:.4f}, head_probe = "
-              f"{measured[name][1]:.4f}, velocity = {measured[name][2]:.4f}")
+        print(
+            f"{n} spheres, {name}: Kd = {kd:.5g}, head_rms = {measured[name][0]:.4f}, head_probe = "
+            f"{measured[name][1]:.4f}, velocity = {measured[name][2]:.4f}"
+        )
     tol = TOLERANCE[num]
     for k, what in enumerate(("head_rms", "head_probe", "velocity")):
         check(f"{n} spheres: PFV {what} within {tol[k]}", measured["PFV"][k] <= tol[k], f"({measured['PFV'][k]:.4f})")
-        check(f"{n} spheres: PFV {what} no larger than YADE's", measured["PFV"][k] <= measured["YADE"][k],
-              f"({measured['PFV'][k]:.4f} vs {measured['YADE'][k]:.4f})")
+        check(
+            f"{n} spheres: PFV {what} no larger than YADE's",
+            measured["PFV"][k] <= measured["YADE"][k],
+            f"({measured['PFV'][k]:.4f} vs {measured['YADE'][k]:.4f})",
+        )
     print(f"({time.time() - start:.1f} s)")
     return measured
 
@@ -201,17 +210,22 @@ def time_dependence():
     flow.set_boundary_pressure(flow.ymax, ramp)
     O.run(1, True)
     p_halfwave = np.array(flow.core.pressure()) * ramp.amplitude_at(0) / ramp.amplitude_at(O.time - O.dt)
-    check("waveAction equals HalfWave(A, L) (same formula)",
-          np.max(np.abs(p_yade_form - p_halfwave)) <= 1e-12 * A, f"({np.max(np.abs(p_yade_form - p_halfwave)):.2g})")
+    check(
+        "waveAction equals HalfWave(A, L) (same formula)",
+        np.max(np.abs(p_yade_form - p_halfwave)) <= 1e-12 * A,
+        f"({np.max(np.abs(p_yade_form - p_halfwave)):.2g})",
+    )
     builds, meshes, evaluations = flow.core.system_builds, flow.core.remesh_count, flow.core.field_evaluations
     ratios = []
     for step in range(10):
         t = O.time
         O.run(1, True)
         ratios.append(np.max(np.abs(np.array(flow.core.pressure()) * A / ramp.amplitude_at(t) - p_yade_form)))
-    check("ramp: no new system nor mesh over 10 steps",
-          (flow.core.system_builds, flow.core.remesh_count) == (builds, meshes),
-          f"(system_builds {builds} -> {flow.core.system_builds}, remesh_count {meshes} -> {flow.core.remesh_count})")
+    check(
+        "ramp: no new system nor mesh over 10 steps",
+        (flow.core.system_builds, flow.core.remesh_count) == (builds, meshes),
+        f"(system_builds {builds} -> {flow.core.system_builds}, remesh_count {meshes} -> {flow.core.remesh_count})",
+    )
     check("ramp: one evaluation per step", flow.core.field_evaluations - evaluations == 10)
     check("ramp: pressures scale with A(t)", max(ratios) <= 1e-10 * A, f"(max deviation {max(ratios):.2g})")
     standing = waves.StandingWave(amplitude=A, period=40 * O.dt, length=L, mean=0.5 * A)
@@ -219,9 +233,16 @@ def time_dependence():
     O.run(1, True)
     top = [c for c in range(flow.nCells()) if flow.getCellPImposed(c)]
     t = O.time - O.dt
-    deviation = max(abs(flow.getCellPressure(c) - (0.5 * A + A * math.sin(2 * math.pi * t / standing.period)
-                                                   * math.cos(math.pi * flow.core.cell_center(c)[0] / L)))
-                    for c in top)
+    deviation = max(
+        abs(
+            flow.getCellPressure(c)
+            - (
+                0.5 * A
+                + A * math.sin(2 * math.pi * t / standing.period) * math.cos(math.pi * flow.core.cell_center(c)[0] / L)
+            )
+        )
+        for c in top
+    )
     check("standing wave: the top cells hold the load of their own x", deviation <= 1e-12 * A, f"({deviation:.2g})")
     check("standing wave: still no new system", flow.core.system_builds == builds)
     flow.clear_boundary_pressure()
@@ -232,8 +253,11 @@ def time_dependence():
 start = time.time()
 time_dependence()
 head_rms = [run_size(num)["PFV"][0] for num in SIZES]
-check(f"PFV's head error falls with the grain size ({SIZES[0]} -> {SIZES[-1]} layers)", head_rms[-1] < head_rms[0],
-      f"({head_rms[0]:.4f} -> {head_rms[-1]:.4f})")
+check(
+    f"PFV's head error falls with the grain size ({SIZES[0]} -> {SIZES[-1]} layers)",
+    head_rms[-1] < head_rms[0],
+    f"({head_rms[0]:.4f} -> {head_rms[-1]:.4f})",
+)
 print(f"total {time.time() - start:.1f} s")
 if failures:
     print(f"{len(failures)} checks failed")

@@ -24,8 +24,10 @@ NAN = float("nan")
 # The permeameter along y (pressure 1 on ymin, 0 on ymax): the load goes on ymax.
 flow = rb.fresh()
 rb.run(1)
-rb.check("no load: the field is never evaluated", flow.core.field_evaluations == 0
-         and flow.core.step_times()["pressure_field"] == 0.0)
+rb.check(
+    "no load: the field is never evaluated",
+    flow.core.field_evaluations == 0 and flow.core.step_times()["pressure_field"] == 0.0,
+)
 q_ref = flow.getBoundaryFlux(2)
 p_ref = np.array(flow.core.pressure())
 
@@ -37,8 +39,10 @@ def step():
 
 
 def unchanged(what):
-    rb.check(f"{what}: the last results are kept", np.array_equal(np.array(flow.core.pressure()), p_ref)
-             and flow.getBoundaryFlux(2) == q_ref)
+    rb.check(
+        f"{what}: the last results are kept",
+        np.array_equal(np.array(flow.core.pressure()), p_ref) and flow.getBoundaryFlux(2) == q_ref,
+    )
 
 
 # 1. set_boundary_pressure: wall and callable.
@@ -88,12 +92,18 @@ rb.check("a load returning a number holds everywhere", abs(flow.getBoundaryFlux(
 with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
     O.saveTmp("function")
-rb.check("O.saveTmp with a function set warns that it is not saved",
-         any("set_boundary_pressure is not saved" in str(w.message) for w in caught))
+rb.check(
+    "O.saveTmp with a function set warns that it is not saved",
+    any("set_boundary_pressure is not saved" in str(w.message) for w in caught),
+)
 
 # 3. waveAction and its values.
-expect_error("waveAction while a function is set", ValueError, "clear_boundary_pressure",
-             lambda: setattr(flow, "waveAction", True))
+expect_error(
+    "waveAction while a function is set",
+    ValueError,
+    "clear_boundary_pressure",
+    lambda: setattr(flow, "waveAction", True),
+)
 flow.clear_boundary_pressure()
 expect_error("waveAction = 'yes'", TypeError, "waveAction", lambda: setattr(flow, "waveAction", "yes"))
 expect_error("waveAction = None", TypeError, "waveAction", lambda: setattr(flow, "waveAction", None))
@@ -101,27 +111,34 @@ expect_error("sineMagnitude = NaN", ValueError, "sineMagnitude", lambda: setattr
 expect_error("sineMagnitude = '1'", TypeError, "sineMagnitude", lambda: setattr(flow, "sineMagnitude", "1"))
 expect_error("sineAverage = inf", ValueError, "sineAverage", lambda: setattr(flow, "sineAverage", math.inf))
 flow.waveAction = True
-expect_error("set_boundary_pressure while waveAction is on", ValueError, "waveAction",
-             lambda: flow.set_boundary_pressure(flow.ymax, lambda *a: 0.0))
+expect_error(
+    "set_boundary_pressure while waveAction is on",
+    ValueError,
+    "waveAction",
+    lambda: flow.set_boundary_pressure(flow.ymax, lambda *a: 0.0),
+)
 flow.bndCondIsPressure = [False, False, True, False, False, False]
 expect_error("waveAction with ymax impermeable", ValueError, "bndCondIsPressure[3]", step)
 flow.bndCondIsPressure = [False, False, True, True, False, False]
 flow.sineAverage, flow.sineMagnitude = 0.25, 0.5
 rb.run(1)
 top = np.nonzero(np.asarray(flow.core.cell_sources()) == flow.ymax)[0].tolist()
-deviation = max(abs(flow.getCellPressure(c) - (0.25 + 0.5 * math.cos(math.pi * flow.getCellCenter(c)[0])))
-                for c in top)
+deviation = max(abs(flow.getCellPressure(c) - (0.25 + 0.5 * math.cos(math.pi * flow.getCellCenter(c)[0]))) for c in top)
 rb.check("waveAction: the top cells hold YADE's formula at their own x", deviation <= 1e-14, f"({deviation:.2g})")
 O.saveTmp("wave")
 O.loadTmp("wave")
 loaded = [e for e in O.engines if isinstance(e, FlowEngine)][0]
-rb.check("O.saveTmp / O.loadTmp keep waveAction and its values",
-         (loaded.waveAction, loaded.sineAverage, loaded.sineMagnitude) == (True, 0.25, 0.5))
+rb.check(
+    "O.saveTmp / O.loadTmp keep waveAction and its values",
+    (loaded.waveAction, loaded.sineAverage, loaded.sineMagnitude) == (True, 0.25, 0.5),
+)
 flow = loaded
 flow.waveAction = False
 rb.run(1)
-rb.check("waveAction off: bndCondValue again", flow.getBoundaryFlux(2) == q_ref or
-         abs(flow.getBoundaryFlux(2) - q_ref) <= 1e-12 * abs(q_ref))
+rb.check(
+    "waveAction off: bndCondValue again",
+    flow.getBoundaryFlux(2) == q_ref or abs(flow.getBoundaryFlux(2) - q_ref) <= 1e-12 * abs(q_ref),
+)
 
 # 4. A background remesh (multithread) and queries from the main thread while O.run() steps.
 flow = rb.fresh(multithread=True, meshUpdateInterval=4)
@@ -132,9 +149,11 @@ meshes, evaluations = flow.core.remesh_count, flow.core.field_evaluations
 for _ in range(12):
     rb.run(1)
     flow.core.wait_for_remesh()  # adopted at the next step, whatever the machine's speed
-rb.check("background remeshes: one evaluation per step", flow.core.field_evaluations - evaluations == 12
-         and flow.core.remesh_count >= meshes + 2,
-         f"({flow.core.field_evaluations - evaluations} evaluations, {flow.core.remesh_count - meshes} remeshes)")
+rb.check(
+    "background remeshes: one evaluation per step",
+    flow.core.field_evaluations - evaluations == 12 and flow.core.remesh_count >= meshes + 2,
+    f"({flow.core.field_evaluations - evaluations} evaluations, {flow.core.remesh_count - meshes} remeshes)",
+)
 evaluations = flow.core.field_evaluations
 O.run(16)
 queries = 0
@@ -142,8 +161,11 @@ while O.running:
     flow.getPorePressure((0.5, 0.5, 0.5))
     queries += 1
 O.wait()
-rb.check("queries during O.run(): no deadlock, one evaluation per step",
-         flow.core.field_evaluations - evaluations == 16, f"({queries} queries)")
+rb.check(
+    "queries during O.run(): no deadlock, one evaluation per step",
+    flow.core.field_evaluations - evaluations == 16,
+    f"({queries} queries)",
+)
 t = O.time - O.dt
 top = np.nonzero(np.asarray(flow.core.cell_sources()) == flow.ymax)[0].tolist()
 deviation = max(abs(flow.getCellPressure(c) - float(wave(np.array(flow.getCellCenter(c)[0]), 0, 0, t))) for c in top)

@@ -25,9 +25,23 @@ work = tempfile.mkdtemp(prefix="pfv-wave-standing-")
 peaks = {}
 for amplitude in (400, 50):
     out = os.path.join(work, f"A{amplitude}")
-    done = subprocess.run(["yade-double", "-n", "-x", script, "--quick", f"--amplitude={amplitude}", "--period=1",
-                           "--duration=3", f"--out={out}"], env=dict(os.environ, OMP_NUM_THREADS="1"),
-                          capture_output=True, text=True, timeout=1200)
+    done = subprocess.run(
+        [
+            "yade-double",
+            "-n",
+            "-x",
+            script,
+            "--quick",
+            f"--amplitude={amplitude}",
+            "--period=1",
+            "--duration=3",
+            f"--out={out}",
+        ],
+        env=dict(os.environ, OMP_NUM_THREADS="1"),
+        capture_output=True,
+        text=True,
+        timeout=1200,
+    )
     if done.returncode != 0:
         print(done.stdout[-3000:], done.stderr[-3000:])
     with open(os.path.join(out, "summary.json")) as f:
@@ -36,12 +50,20 @@ for amplitude in (400, 50):
     steps = s["time_steps"]
     rb.check(f"A = {amplitude} Pa: no TimeStepWarning", "TimeStepWarning" not in done.stderr + done.stdout)
     margin = steps["first_step"] / (0.8 * steps["collective_viscous"])
-    rb.check(f"A = {amplitude} Pa: the first step is at most half the guard's limit", margin <= 0.5,
-             f"({margin:.2f}; collective limit {steps['collective_viscous'] / steps['viscous']:.2f} dt_MV)")
-    print(f"A = {amplitude} Pa: peak period-mean grad H / i_c {s['peak_mean_ratio']:.3f}, "
-          f"n {s['porosity0']:.3f} -> {s['final_porosity']:.3f}, {s['steps']} steps")
+    rb.check(
+        f"A = {amplitude} Pa: the first step is at most half the guard's limit",
+        margin <= 0.5,
+        f"({margin:.2f}; collective limit {steps['collective_viscous'] / steps['viscous']:.2f} dt_MV)",
+    )
+    print(
+        f"A = {amplitude} Pa: peak period-mean grad H / i_c {s['peak_mean_ratio']:.3f}, "
+        f"n {s['porosity0']:.3f} -> {s['final_porosity']:.3f}, {s['steps']} steps"
+    )
 rb.check("A = 400 Pa liquefies (grad H / i_c > 0.8)", peaks[400] > 0.8, f"({peaks[400]:.3f})")
 rb.check("A = 50 Pa does not", peaks[50] < 0.8, f"({peaks[50]:.3f})")
-rb.check("the large amplitude drives the gradient well above the small one", peaks[400] >= 1.5 * peaks[50],
-         f"({peaks[400]:.3f} vs {peaks[50]:.3f})")
+rb.check(
+    "the large amplitude drives the gradient well above the small one",
+    peaks[400] >= 1.5 * peaks[50],
+    f"({peaks[400]:.3f} vs {peaks[50]:.3f})",
+)
 rb.report("standing wave")

@@ -90,7 +90,8 @@ def check_default(name: str, value: Any) -> None:
     if not same:
         raise NotImplementedError(
             f"pfv.FlowEngine does not support YADE FlowEngine attribute '{name}' yet "
-            f"(only its default value {expected!r} is accepted)")
+            f"(only its default value {expected!r} is accepted)"
+        )
 
 
 def unsupported_method(name: str) -> NotImplementedError:
@@ -121,8 +122,9 @@ def _six(name: str, value: Any, kinds: tuple[type, ...], what: str, each: str) -
     """The six items of `value`, each an instance of `kinds`, else TypeError naming `name`.
     Strict as YADE's own converters are: no truthiness of strings or None, no truncation."""
     if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
-        raise TypeError(f"{name} must be a sequence of 6 {what} (xmin, xmax, ymin, ymax, zmin, zmax), "
-                        f"got {value!r}")
+        raise TypeError(
+            f"{name} must be a sequence of 6 {what} (xmin, xmax, ymin, ymax, zmin, zmax), " f"got {value!r}"
+        )
     items = list(value)
     if len(items) != 6:
         raise ValueError(f"{name} needs 6 values (xmin, xmax, ymin, ymax, zmin, zmax), got {len(items)}")

@@ -53,8 +53,10 @@ class BoundaryPressure:
         if value == self._wave_action:
             return
         if value and self._function is not None:
-            raise ValueError("waveAction: a boundary pressure function is set (set_boundary_pressure); clear it "
-                             "first (clear_boundary_pressure), the engine takes one time-dependent load")
+            raise ValueError(
+                "waveAction: a boundary pressure function is set (set_boundary_pressure); clear it "
+                "first (clear_boundary_pressure), the engine takes one time-dependent load"
+            )
         self._wave_action = value
         self._install((_YADE_WAVE_WALL, self._yade_wave) if value else None)
 
@@ -123,8 +125,10 @@ class BoundaryPressure:
         if not callable(pressure):
             raise TypeError(f"set_boundary_pressure pressure must be a callable p(x, y, z, t), got {pressure!r}")
         if self._wave_action:
-            raise ValueError("set_boundary_pressure: waveAction is on; set waveAction = False first, the engine "
-                             "takes one time-dependent load")
+            raise ValueError(
+                "set_boundary_pressure: waveAction is on; set waveAction = False first, the engine "
+                "takes one time-dependent load"
+            )
         self._install((wall, pressure))
 
     def clear_boundary_pressure(self) -> None:
@@ -158,8 +162,10 @@ class BoundaryPressure:
         wall = self._function[0]
         if not self._core.bnd_is_pressure[wall]:
             name = "waveAction" if self._wave_action else "set_boundary_pressure"
-            raise ValueError(f"{name}: wall {wall} ({WALL_NAMES[wall]}) is not a pressure boundary; set "
-                             f"bndCondIsPressure[{wall}] = True")
+            raise ValueError(
+                f"{name}: wall {wall} ({WALL_NAMES[wall]}) is not a pressure boundary; set "
+                f"bndCondIsPressure[{wall}] = True"
+            )
         self._time = float(scene.time)
         self._walls = tuple(walls)
 
@@ -178,21 +184,29 @@ class BoundaryPressure:
         if p.ndim == 0:
             p = np.full(n, float(p))
         elif p.shape != (n,):
-            raise ValueError(f"{name}: the pressure function returned shape {p.shape} for {n} boundary cells; "
-                             f"it must return one pressure per cell, shape ({n},)")
+            raise ValueError(
+                f"{name}: the pressure function returned shape {p.shape} for {n} boundary cells; "
+                f"it must return one pressure per cell, shape ({n},)"
+            )
         bad = ~np.isfinite(p)
         if bad.any():
             i = int(np.argmax(bad))
-            raise ValueError(f"{name}: the pressure function gave {p[i]} (not finite) at {tuple(positions[i])}, "
-                             f"t = {self._time} ({int(bad.sum())} of {n} cells)")
+            raise ValueError(
+                f"{name}: the pressure function gave {p[i]} (not finite) at {tuple(positions[i])}, "
+                f"t = {self._time} ({int(bad.sum())} of {n} cells)"
+            )
         return np.ascontiguousarray(p)
 
     # -- O.save / O.load ----------------------------------------------------------------------------
     def saved(self) -> dict[str, Any]:
         """The settings (a function of set_boundary_pressure is not saved: the engine warns)."""
-        return {"wave_action": self._wave_action, "sine_magnitude": self._sine_magnitude,
-                "sine_average": self._sine_average, "boundary_x_pos": list(self._x_pos),
-                "boundary_pressure": list(self._pressures)}
+        return {
+            "wave_action": self._wave_action,
+            "sine_magnitude": self._sine_magnitude,
+            "sine_average": self._sine_average,
+            "boundary_x_pos": list(self._x_pos),
+            "boundary_pressure": list(self._pressures),
+        }
 
     def restore(self, state: dict[str, Any]) -> None:
         self.sineMagnitude = state["sine_magnitude"]

@@ -32,8 +32,9 @@ class CellConditions:
     def imposePressure(self, pos: Sequence[float], p: float) -> int:
         """Impose pressure p in the cell containing pos; returns the condition's index. A point
         outside the pore space is refused (at once once there is a mesh, else at the first step)."""
-        return self._core.impose_pressure(attributes.as_point("imposePressure position", pos),
-                                          attributes.as_number("imposePressure pressure", p))
+        return self._core.impose_pressure(
+            attributes.as_point("imposePressure position", pos), attributes.as_number("imposePressure pressure", p)
+        )
 
     def setImposedPressure(self, cond: int, p: float) -> None:
         """Change the pressure of the imposed condition number cond."""
@@ -44,8 +45,9 @@ class CellConditions:
 
     def imposeFlux(self, pos: Sequence[float], p: float) -> None:
         """YADE's sign: outflux positive, influx negative. A point outside the pore space is refused."""
-        self._core.impose_flux(attributes.as_point("imposeFlux position", pos),
-                               -attributes.as_number("imposeFlux flux", p))
+        self._core.impose_flux(
+            attributes.as_point("imposeFlux position", pos), -attributes.as_number("imposeFlux flux", p)
+        )
 
     def clearImposedFlux(self) -> None:
         self._core.clear_imposed_flux()

@@ -131,7 +131,8 @@ class CoupledBodies:
         if not np.allclose(normal, _NORMALS[index], rtol=0, atol=1e-12):
             raise NotImplementedError(
                 f"pfv.FlowEngine: boundary {index} is the axis-aligned plane with normal {_NORMALS[index]}; other "
-                "normals are not supported")
+                "normals are not supported"
+            )
 
     def _bodies_changed(self) -> None:
         """The bodies must be scanned again at the next step (which remeshes)."""
@@ -146,9 +147,16 @@ class CoupledBodies:
         if self._id_offset < 0:
             self._id_offset = len(yade.O.bodies)
             self._wall_ids = [self._id_offset + w for w in range(6)]
-        self.scan = SceneScan(self._wall_ids, self._use_max_min, use_sphere_pack=self.use_sphere_pack,
-                              warned=self._warned, previous=self.scan, mask=self._mask,
-                              convert_clumps=self._convert_clumps, wall_thickness=self._wall_thickness)
+        self.scan = SceneScan(
+            self._wall_ids,
+            self._use_max_min,
+            use_sphere_pack=self.use_sphere_pack,
+            warned=self._warned,
+            previous=self.scan,
+            mask=self._mask,
+            convert_clumps=self._convert_clumps,
+            wall_thickness=self._wall_thickness,
+        )
         return self.scan
 
     def scanned(self) -> SceneScan:
@@ -237,10 +245,15 @@ class CoupledBodies:
 
     # -- O.save / O.load ----------------------------------------------------------------------------
     def saved(self) -> dict[str, Any]:
-        return {"boundary_use_max_min": list(self._use_max_min), "wall_ids": list(self._wall_ids),
-                "mask": self._mask, "convert_clumps": self._convert_clumps,
-                "wall_thickness": self._wall_thickness, "id_offset": self._id_offset,
-                "use_sphere_pack": self.use_sphere_pack}
+        return {
+            "boundary_use_max_min": list(self._use_max_min),
+            "wall_ids": list(self._wall_ids),
+            "mask": self._mask,
+            "convert_clumps": self._convert_clumps,
+            "wall_thickness": self._wall_thickness,
+            "id_offset": self._id_offset,
+            "use_sphere_pack": self.use_sphere_pack,
+        }
 
     def restore(self, state: dict[str, Any]) -> None:
         """The settings of saved(), as they were (no remesh requested: the core's run state follows)."""

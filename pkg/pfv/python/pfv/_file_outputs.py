@@ -99,7 +99,7 @@ class FileOutputs:
             row_start = np.searchsorted(lower_row[by_row], np.arange(n + 1))
             for r in range(n):
                 line = ["0"] * n
-                for k in by_row[row_start[r]:row_start[r + 1]]:
+                for k in by_row[row_start[r] : row_start[r + 1]]:
                     line[lower_col[k]] = text[k]
                 f.write(" ".join(line) + " \n")
 
@@ -109,8 +109,9 @@ class FileOutputs:
         if not self._core.print_cholmod_statistics("PFV Cholmod factorization"):
             print("cholmodStats: the current solver is not CHOLMOD (useSolver=3)", file=sys.stderr)
 
-    def saveVtk(self, folder: str | os.PathLike = "./VTK", withBoundaries: bool = False,
-                compress: bool = False) -> None:
+    def saveVtk(
+        self, folder: str | os.PathLike = "./VTK", withBoundaries: bool = False, compress: bool = False
+    ) -> None:
         """Write the pore network (pressure, mean fluid velocity, imposed-pressure flag, volumes) and the spheres
         (radii, ids, fluid forces) of the last step into `folder` as VTK XML files for ParaView: out_<N>.vtu,
         spheres_<N>.vtu and the collection out.pvd of every snapshot this process wrote there, at O.time.
@@ -123,8 +124,9 @@ class FileOutputs:
         try:
             from . import _vtk_output
         except ImportError as error:
-            raise ImportError(f"pfv.FlowEngine.saveVtk needs VTK's Python package (Debian: apt-get install "
-                              f"python3-vtk9): {error}") from None
+            raise ImportError(
+                f"pfv.FlowEngine.saveVtk needs VTK's Python package (Debian: apt-get install " f"python3-vtk9): {error}"
+            ) from None
         with self._lock:
             self._bodies.require_mesh()
             scan = self._bodies.stepped

@@ -90,8 +90,12 @@ class FlowQueries:
         neighbours = self._core.cell_neighbour_array()
         touches = (cv >= n).any(axis=1)
         on_wall = np.nonzero((cv == n + wall).any(axis=1))[0]
-        pairs = [(c, local) for c in on_wall for local in range(4)
-                 if neighbours[c, local] >= 0 and not touches[neighbours[c, local]]]
+        pairs = [
+            (c, local)
+            for c in on_wall
+            for local in range(4)
+            if neighbours[c, local] >= 0 and not touches[neighbours[c, local]]
+        ]
         cells = np.array([c for c, _ in pairs], dtype=int)
         areas = np.array([self._throat_fluid_area(c, local) for c, local in pairs])
         return cells, areas

@@ -20,15 +20,18 @@ from typing import Any, Callable
 
 def exclusive(method: Callable[..., Any]) -> Callable[..., Any]:
     """Run an engine method under the engine's lock."""
+
     @functools.wraps(method)
     def locked(self, *args, **kwargs):
         with self._lock:
             return method(self, *args, **kwargs)
+
     return locked
 
 
 def setting(part: str, member: property) -> property:
     """An engine property that reads and writes the property `member` of its part `part`."""
+
     def get(engine):
         with engine._lock:
             return member.fget(getattr(engine, part))
@@ -38,16 +41,19 @@ def setting(part: str, member: property) -> property:
             raise AttributeError(f"{member.fget.__name__} is read-only (computed by the engine)")
         with engine._lock:
             member.fset(getattr(engine, part), value)
+
     return property(get, set_, doc=member.__doc__)
 
 
 def method(part: str, function: Callable[..., Any], locked: bool = True) -> Callable[..., Any]:
     """An engine method that calls the method `function` of its part `part`; `locked` False for a
     method that takes the lock itself, for its part that needs it."""
+
     @functools.wraps(function)
     def forwarded(engine, *args, **kwargs):
         if not locked:
             return function(getattr(engine, part), *args, **kwargs)
         with engine._lock:
             return function(getattr(engine, part), *args, **kwargs)
+
     return forwarded

@@ -93,9 +93,14 @@ class KeptSettings:
 
     # -- O.save / O.load ----------------------------------------------------------------------------
     def saved(self) -> dict[str, Any]:
-        return {"permeability_map": self._permeability_map, "solve_threads": self._solve_threads,
-                "factorize_threads": self._factorize_threads, "boundary_velocity": self._boundary_velocity,
-                "ids": self._ids, "volume_factor": self._volume_factor}
+        return {
+            "permeability_map": self._permeability_map,
+            "solve_threads": self._solve_threads,
+            "factorize_threads": self._factorize_threads,
+            "boundary_velocity": self._boundary_velocity,
+            "ids": self._ids,
+            "volume_factor": self._volume_factor,
+        }
 
     def restore(self, state: dict[str, Any]) -> None:
         self._permeability_map = state["permeability_map"]

@@ -52,6 +52,7 @@ def _decode(value: Any) -> Any:
 
 def _flow_engine_class() -> type:
     from .flow_engine import FlowEngine  # circular at import time: flow_engine installs this module
+
     return FlowEngine
 
 

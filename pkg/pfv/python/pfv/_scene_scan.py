@@ -35,9 +35,11 @@ def _equivalent_radius(scene, clump) -> float:
     for member in clump.shape.members.keys():
         shape = scene.bodies[member].shape
         if not isinstance(shape, Sphere):
-            raise NotImplementedError(f"pfv.FlowEngine: clump #{clump.id} has a member that is not a sphere "
-                                      f"(#{member}, {type(shape).__name__})")
-        cubes += shape.radius ** 3
+            raise NotImplementedError(
+                f"pfv.FlowEngine: clump #{clump.id} has a member that is not a sphere "
+                f"(#{member}, {type(shape).__name__})"
+            )
+        cubes += shape.radius**3
     return cubes ** (1.0 / 3.0)
 
 
@@ -91,8 +93,9 @@ class _CoupledSpheres:
         state = b.state
         mass = state.mass
         if not math.isfinite(mass) or mass < 0:
-            raise ValueError(f"pfv.FlowEngine: sphere #{bid} has mass {mass}: a coupled sphere needs a "
-                             "finite mass >= 0")
+            raise ValueError(
+                f"pfv.FlowEngine: sphere #{bid} has mass {mass}: a coupled sphere needs a " "finite mass >= 0"
+            )
         moving = b.dynamic and mass > 0 and state.blockedDOFs != "xyzXYZ"
         self.masses.append(mass if moving else 0.0)
         if moving:
@@ -110,9 +113,18 @@ class SceneScan:
     body bounds the domain at this half thickness from its centre) are applied as YADE does.
     """
 
-    def __init__(self, wall_ids: Sequence[int], use_max_min: Sequence[bool], *, use_sphere_pack: bool = True,
-                 warned: set[str] | None = None, previous: SceneScan | None = None, mask: int = 0,
-                 convert_clumps: bool = True, wall_thickness: float = 0.0) -> None:
+    def __init__(
+        self,
+        wall_ids: Sequence[int],
+        use_max_min: Sequence[bool],
+        *,
+        use_sphere_pack: bool = True,
+        warned: set[str] | None = None,
+        previous: SceneScan | None = None,
+        mask: int = 0,
+        convert_clumps: bool = True,
+        wall_thickness: float = 0.0,
+    ) -> None:
         scene = yade.O
         if scene.periodic:
             raise NotImplementedError("pfv.FlowEngine does not support periodic scenes yet")
@@ -121,30 +133,35 @@ class SceneScan:
         spheres = _CoupledSpheres(scene, set(self.wall_ids), mask, convert_clumps)
         ids = spheres.ids
         if not ids:
-            raise ValueError(f"pfv.FlowEngine: the scene has no sphere to couple with the fluid "
-                             f"({len(spheres.row_of)} bodies, walls wallIds = {self.wall_ids})")
+            raise ValueError(
+                f"pfv.FlowEngine: the scene has no sphere to couple with the fluid "
+                f"({len(spheres.row_of)} bodies, walls wallIds = {self.wall_ids})"
+            )
         self.clumps = spheres.clumps  # clumps entered as their equivalent spheres
         if warned is None:
             warned = set()
         if spheres.others and "others" not in warned:
             warned.add("others")
             # stacklevel 4: the engine's step, the caller of CoupledBodies.rescan.
-            warnings.warn(f"pfv.FlowEngine: {spheres.others} bodies that are neither spheres nor the six walls "
-                          "are left out of the flow", stacklevel=4)
+            warnings.warn(
+                f"pfv.FlowEngine: {spheres.others} bodies that are neither spheres nor the six walls "
+                "are left out of the flow",
+                stacklevel=4,
+            )
         wall_rows, wall_half = self._scan_walls(scene, spheres.row_of, use_max_min, wall_thickness)
         vertex_of_id = {bid: k for k, bid in enumerate(ids)}
         for w, bid in enumerate(self.wall_ids):
             vertex_of_id.setdefault(bid, len(ids) + w)
-        self.ids = np.array(ids, dtype=np.int64)          # YADE ids of the coupled spheres
+        self.ids = np.array(ids, dtype=np.int64)  # YADE ids of the coupled spheres
         self.rows = np.array(spheres.rows, dtype=np.int64)  # their rows in O.bodies
         self.radii = np.array(spheres.radii, dtype=float)
         self.masses = np.array(spheres.masses, dtype=float)  # 0 for spheres that do not move
         self.mass_per_diameter = spheres.mass_per_diameter
-        self.wall_rows = wall_rows                        # -1: wall not in the scene
-        self.wall_half = wall_half                        # inner face - centre, along the wall's axis
+        self.wall_rows = wall_rows  # -1: wall not in the scene
+        self.wall_half = wall_half  # inner face - centre, along the wall's axis
         self.n_bodies = len(scene.bodies)
-        self.n_listed = len(spheres.row_of)               # bodies in the coordinate lists
-        self.vertex_of_id = vertex_of_id                  # body id -> row of core.forces()
+        self.n_listed = len(spheres.row_of)  # bodies in the coordinate lists
+        self.vertex_of_id = vertex_of_id  # body id -> row of core.forces()
         self._bridge_key, self.force_bridge = self._make_force_bridge(ids, wall_rows, previous)
         dem = yade.utils.PWaveTimeStep() if ids else float("inf")
         self.dt_dem = dem if dem > 0 else float("inf")
@@ -154,11 +171,11 @@ class SceneScan:
         self.pack_index: np.ndarray | None = None  # the spheres' places in the pack
         self.pack_size = 0  # sphere bodies in the pack
         if use_sphere_pack and not spheres.clumps:  # a SpherePack lists no clump bodies
-            self._choose_position_reader(np.array(spheres.pack_index, dtype=np.int64), spheres.pack_size,
-                                         use_max_min)
+            self._choose_position_reader(np.array(spheres.pack_index, dtype=np.int64), spheres.pack_size, use_max_min)
 
-    def _scan_walls(self, scene, row_of: dict[int, int], use_max_min: Sequence[bool],
-                    wall_thickness: float) -> tuple[list[int], list[float]]:
+    def _scan_walls(
+        self, scene, row_of: dict[int, int], use_max_min: Sequence[bool], wall_thickness: float
+    ) -> tuple[list[int], list[float]]:
         """Each wall's row in O.bodies (-1: not a body) and the offset of its inner face from its centre."""
         wall_rows, wall_half = [], []
         for w, bid in enumerate(self.wall_ids):
@@ -171,8 +188,9 @@ class SceneScan:
             b = scene.bodies[bid]
             # The body's position bounds the domain unless boundaryUseMaxMin: it must be a wall.
             if not use_max_min[w] and (not isinstance(b.shape, _WALL_SHAPES) or b.isClump or b.isClumpMember):
-                raise ValueError(f"wallIds[{w}] = {bid} names a {type(b.shape).__name__} body, not a wall "
-                                 "(a Box, Wall or Facet)")
+                raise ValueError(
+                    f"wallIds[{w}] = {bid} names a {type(b.shape).__name__} body, not a wall " "(a Box, Wall or Facet)"
+                )
             wall_rows.append(row_of[bid])
             # A box wall bounds the domain with its inner face, unless wallThickness says where.
             if wall_thickness > 0:
@@ -182,8 +200,9 @@ class SceneScan:
             wall_half.append(-half if w % 2 else half)
         return wall_rows, wall_half
 
-    def _make_force_bridge(self, ids: list[int], wall_rows: list[int],
-                           previous: SceneScan | None) -> tuple[tuple[list[int], list[int]], YadeForceBridge]:
+    def _make_force_bridge(
+        self, ids: list[int], wall_rows: list[int], previous: SceneScan | None
+    ) -> tuple[tuple[list[int], list[int]], YadeForceBridge]:
         """Spheres get force rows 0..n-1, the walls present rows n + w; the previous scan's bridge is
         kept when it maps the same bodies (its Vector3s are made once)."""
         bridge_ids = ids + [bid for w, bid in enumerate(self.wall_ids) if wall_rows[w] >= 0]
@@ -191,8 +210,9 @@ class SceneScan:
         key = (bridge_ids, bridge_rows)
         if previous is not None and previous._bridge_key == key:
             return key, previous.force_bridge
-        return key, YadeForceBridge(Vector3, np.array(bridge_ids, dtype=np.int64),
-                                    np.array(bridge_rows, dtype=np.int64))
+        return key, YadeForceBridge(
+            Vector3, np.array(bridge_ids, dtype=np.int64), np.array(bridge_rows, dtype=np.int64)
+        )
 
     def _choose_position_reader(self, pack_index: np.ndarray, pack_size: int, use_max_min: Sequence[bool]) -> None:
         """Read the centres from a SpherePack (pkg/pfv/yade_bridge/yade_sphere_pack.hpp) if this YADE's pack gives,
@@ -210,7 +230,7 @@ class SceneScan:
 
     @property
     def position_source(self) -> str:
-        """"SpherePack" or "coordinate lists" (see FlowEngine.position_source)."""
+        """ "SpherePack" or "coordinate lists" (see FlowEngine.position_source)."""
         return "SpherePack" if self.pack is not None else "coordinate lists"
 
     def read_positions(self, use_max_min: Sequence[bool]) -> tuple[np.ndarray, list[float]] | None:
@@ -269,9 +289,11 @@ class SceneScan:
                 self._wall_setter.pop(w, None)
 
     def describe_wall_setter(self, w: int) -> str | None:
-        """"wall w is placed by sphere #id at (x, y, z)" when boundaryUseMaxMin placed it, else None."""
+        """ "wall w is placed by sphere #id at (x, y, z)" when boundaryUseMaxMin placed it, else None."""
         k = self._wall_setter.get(w)
         if k is None or self._positions is None or k >= len(self.ids):
             return None
-        return (f"wall {w} is placed by sphere #{self.ids[k]} at {tuple(self._positions[k].tolist())} "
-                "(boundaryUseMaxMin)")
+        return (
+            f"wall {w} is placed by sphere #{self.ids[k]} at {tuple(self._positions[k].tolist())} "
+            "(boundaryUseMaxMin)"
+        )

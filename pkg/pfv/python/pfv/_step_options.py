@@ -59,14 +59,17 @@ class StepOptions:
             return
         low, high = (pos - radii[:, None]).min(axis=0), (pos + radii[:, None]).max(axis=0)
         box = float(np.prod(high - low))
-        porosity = (box - 4.0 / 3.0 * math.pi * float(np.sum(radii ** 3))) / box
+        porosity = (box - 4.0 / 3.0 * math.pi * float(np.sum(radii**3))) / box
         if porosity > 0:
             self._core.volume_correction = self._desired_porosity / porosity
 
     # -- O.save / O.load ----------------------------------------------------------------------------
     def saved(self) -> dict[str, Any]:
-        return {"pressure_force": self._pressure_force, "decouple_forces": self._decouple_forces,
-                "desired_porosity": self._desired_porosity}
+        return {
+            "pressure_force": self._pressure_force,
+            "decouple_forces": self._decouple_forces,
+            "desired_porosity": self._desired_porosity,
+        }
 
     def restore(self, state: dict[str, Any]) -> None:
         self._pressure_force = state["pressure_force"]

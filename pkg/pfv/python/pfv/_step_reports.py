@@ -82,6 +82,7 @@ class StepReports:
 
     def run_block_hook(self) -> None:
         import __main__
+
         exec(compile(self._block_hook, "blockHook", "exec"), vars(__main__))
 
     def before_step(self) -> tuple[int, int] | None:
@@ -99,15 +100,19 @@ class StepReports:
             self.run_block_hook()
         if self._perf_timings and rebuilt:
             t = core.system_times()
-            print(f"CHOLMOD Time to build linear equations {round(t['assembly'] * 1e6)}\n"
-                  f"CHOLMOD Time to analyze {round(t['analysis'] * 1e6)}\n"
-                  f"CHOLMOD Time to factorize {round(t['factorization'] * 1e6)}  (microseconds, pfv)")
+            print(
+                f"CHOLMOD Time to build linear equations {round(t['assembly'] * 1e6)}\n"
+                f"CHOLMOD Time to analyze {round(t['analysis'] * 1e6)}\n"
+                f"CHOLMOD Time to factorize {round(t['factorization'] * 1e6)}  (microseconds, pfv)"
+            )
         if self._mean_k_stat and remeshed:
             self._print_clamped()
         if self._debug:
-            print(f"pfv.FlowEngine: iter {yade.O.iter}: {'remeshed, ' if remeshed else ''}"
-                  f"{'new system, ' if rebuilt else ''}{core.n_cells()} cells, "
-                  f"solve {core.step_times()['solve']:.3g} s")
+            print(
+                f"pfv.FlowEngine: iter {yade.O.iter}: {'remeshed, ' if remeshed else ''}"
+                f"{'new system, ' if rebuilt else ''}{core.n_cells()} cells, "
+                f"solve {core.step_times()['solve']:.3g} s"
+            )
 
     def _print_clamped(self) -> None:
         core = self._core
@@ -116,14 +121,20 @@ class StepReports:
         if len(k):
             median = float(np.median(k))
             low, high = core.min_k_div_k_mean * median, core.max_k_div_k_mean * median
-            print(f"meanKStat (pfv): median k {median:.6g}; {int(np.sum(np.isclose(k, low)))} throats at "
-                  f"minKdivKmean x median, {int(np.sum(np.isclose(k, high)))} at maxKdivKmean x median"
-                  + ("" if core.clamp_k_values else " (clampKValues off)"))
+            print(
+                f"meanKStat (pfv): median k {median:.6g}; {int(np.sum(np.isclose(k, low)))} throats at "
+                f"minKdivKmean x median, {int(np.sum(np.isclose(k, high)))} at maxKdivKmean x median"
+                + ("" if core.clamp_k_values else " (clampKValues off)")
+            )
 
     # -- O.save / O.load ----------------------------------------------------------------------------
     def saved(self) -> dict[str, Any]:
-        return {"block_hook": self._block_hook, "debug": self._debug, "perf_timings": self._perf_timings,
-                "mean_k_stat": self._mean_k_stat}
+        return {
+            "block_hook": self._block_hook,
+            "debug": self._debug,
+            "perf_timings": self._perf_timings,
+            "mean_k_stat": self._mean_k_stat,
+        }
 
     def restore(self, state: dict[str, Any]) -> None:
         self._block_hook = state["block_hook"]

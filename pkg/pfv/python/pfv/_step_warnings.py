@@ -39,14 +39,19 @@ class StepWarnings:
         """The warnings of the step just made at O.iter = `iteration` with the spheres of `scan`."""
         inverted = core.inversion_remeshes != watch.inversions
         if not core.converged and self.once("unconverged"):
-            warnings.warn(f"pfv.FlowEngine: at iteration {iteration} the {core.solver.replace('_', ' ')} solve "
-                          f"stopped at {core.max_iterations} iterations above tolerance = {core.tolerance:g}; "
-                          "the pressures are not converged (raise the tolerance or use useSolver=3)", stacklevel=3)
+            warnings.warn(
+                f"pfv.FlowEngine: at iteration {iteration} the {core.solver.replace('_', ' ')} solve "
+                f"stopped at {core.max_iterations} iterations above tolerance = {core.tolerance:g}; "
+                "the pressures are not converged (raise the tolerance or use useSolver=3)",
+                stacklevel=3,
+            )
         if inverted and self.once("inverted"):
-            warnings.warn(f"pfv.FlowEngine: at iteration {iteration} spheres had moved so far since the last "
-                          "remesh that 2 % of the pore volume was turned inside out; remeshed (and will again "
-                          "whenever this happens). Lower meshUpdateInterval or defTolerance for motion this fast",
-                          stacklevel=3)
+            warnings.warn(
+                f"pfv.FlowEngine: at iteration {iteration} spheres had moved so far since the last "
+                "remesh that 2 % of the pore volume was turned inside out; remeshed (and will again "
+                "whenever this happens). Lower meshUpdateInterval or defTolerance for motion this fast",
+                stacklevel=3,
+            )
         self._auto_multigrid(core, iteration)
         if watch.remeshing or inverted:
             self._hidden_spheres(core, scan)
@@ -60,14 +65,20 @@ class StepWarnings:
         if core.solver == "auto" and choice.startswith("multigrid: the Cholesky"):  # not "kept from ..."
             self.given.add("auto multigrid")
             bound = ", or raise max_factor_bytes" if "budget" in choice else ""  # not CHOLMOD's index range
-            warnings.warn(f"pfv.FlowEngine: solver='auto' solves by multigrid from iteration {iteration}: "
-                          f"{choice[len('multigrid: '):]}. Set solver='multigrid' to skip the Cholesky "
-                          f"analysis at the start{bound}", stacklevel=4)
+            warnings.warn(
+                f"pfv.FlowEngine: solver='auto' solves by multigrid from iteration {iteration}: "
+                f"{choice[len('multigrid: '):]}. Set solver='multigrid' to skip the Cholesky "
+                f"analysis at the start{bound}",
+                stacklevel=4,
+            )
 
     @staticmethod
     def _hidden_spheres(core: Any, scan: Any) -> None:
         hidden = core.hidden_spheres()
         if hidden:
             yade_ids = scan.ids[hidden][:10].tolist()
-            warnings.warn(f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
-                          f"regular triangulation and get no fluid force (ids {yade_ids}...)", stacklevel=4)
+            warnings.warn(
+                f"pfv.FlowEngine: {len(hidden)} spheres are hidden by larger neighbours in the "
+                f"regular triangulation and get no fluid force (ids {yade_ids}...)",
+                stacklevel=4,
+            )

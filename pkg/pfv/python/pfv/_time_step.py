@@ -41,10 +41,10 @@ class TimeStepGuard:
     """The collective viscous limit of the current mesh and the unsafe-step warning."""
 
     def __init__(self) -> None:
-        self.safety = 0.8             # O.dt must stay below safety * min(limits)
-        self.strict = False           # raise ValueError instead of warning
-        self.iterations = 40          # operator applications at most, cold start (first mesh)
-        self.iterations_warm = 10     # operator applications at most, warm start (later meshes)
+        self.safety = 0.8  # O.dt must stay below safety * min(limits)
+        self.strict = False  # raise ValueError instead of warning
+        self.iterations = 40  # operator applications at most, cold start (first mesh)
+        self.iterations_warm = 10  # operator applications at most, warm start (later meshes)
         self._limit: float | None = None
         self._limit_state: tuple[int, float, bool] | None = None  # the _state the limit was computed in
         self._mode: np.ndarray | None = None  # its eigenvector, the next mesh's start
@@ -72,8 +72,9 @@ class TimeStepGuard:
         state = self._state(core)
         return self._limit_state != state and self._bound_state != state
 
-    def limit_to_check(self, core: Any, masses: np.ndarray, dt: float, other_limits: float, iteration: int,
-                       before_step: bool = False) -> float:
+    def limit_to_check(
+        self, core: Any, masses: np.ndarray, dt: float, other_limits: float, iteration: int, before_step: bool = False
+    ) -> float:
         """The collective limit to check dt against: the limit if computed for the core's mesh as it is,
         else its certified lower bound when that shows dt safe (dt <= safety * min(bound, other_limits)),
         else the limit, computed now. Before a step (`before_step`) nothing is computed for a mesh about
@@ -86,9 +87,18 @@ class TimeStepGuard:
         if self._bound_state != state:
             t0 = time.perf_counter()
             self._bound, self._bound_state = core.viscous_stability_bound(masses), state
-            self._history.append(dict(
-                iter=iteration, remesh_count=state[0], limit=self._bound, iterations=0, max_iterations=0,
-                warm=False, method="bound", seconds=time.perf_counter() - t0))
+            self._history.append(
+                dict(
+                    iter=iteration,
+                    remesh_count=state[0],
+                    limit=self._bound,
+                    iterations=0,
+                    max_iterations=0,
+                    warm=False,
+                    method="bound",
+                    seconds=time.perf_counter() - t0,
+                )
+            )
         if dt <= self.safety * min(self._bound, other_limits):
             return self._bound
         return self.collective_limit(core, masses, iteration)
@@ -103,17 +113,30 @@ class TimeStepGuard:
             mode = self._mode
             # Warm only from the mesh just before: a mode older than that (meshes the bound sufficed
             # for) may be far from the new one, and power iteration is only accurate from close by.
-            warm = (mode is not None and len(mode) == len(masses) and self._limit_state is not None
-                    and self._limit_state[0] in (state[0], state[0] - 1))
+            warm = (
+                mode is not None
+                and len(mode) == len(masses)
+                and self._limit_state is not None
+                and self._limit_state[0] in (state[0], state[0] - 1)
+            )
             iterations = self.iterations_warm if warm else self.iterations
             t0 = time.perf_counter()
             limit, mode, applied = core.viscous_stability_mode(masses, iterations, mode if warm else None)
             seconds = time.perf_counter() - t0
             self._limit, self._limit_state = limit, state
             self._mode = mode if len(mode) else None
-            self._history.append(dict(
-                iter=iteration, remesh_count=state[0], limit=limit, iterations=applied,
-                max_iterations=iterations, warm=warm, method="power" if warm else "arnoldi", seconds=seconds))
+            self._history.append(
+                dict(
+                    iter=iteration,
+                    remesh_count=state[0],
+                    limit=limit,
+                    iterations=applied,
+                    max_iterations=iterations,
+                    warm=warm,
+                    method="power" if warm else "arnoldi",
+                    seconds=seconds,
+                )
+            )
         return self._limit
 
     @property
@@ -127,10 +150,12 @@ class TimeStepGuard:
         if dt <= limit:
             self._unsafe = False
             return
-        message = (f"pfv.FlowEngine: O.dt = {dt:.4g} exceeds the coupled stability limit "
-                   f"{self.safety:g} x min(dt_MV = {dt_mv:.4g}, collective viscous limit = "
-                   f"{dt_collective:.4g}, dt_DEM = {dt_dem:.4g}) = {limit:.4g}; "
-                   f"the explicit coupling may blow up (thesis 4.20-4.22)")
+        message = (
+            f"pfv.FlowEngine: O.dt = {dt:.4g} exceeds the coupled stability limit "
+            f"{self.safety:g} x min(dt_MV = {dt_mv:.4g}, collective viscous limit = "
+            f"{dt_collective:.4g}, dt_DEM = {dt_dem:.4g}) = {limit:.4g}; "
+            f"the explicit coupling may blow up (thesis 4.20-4.22)"
+        )
         if self.strict:
             raise ValueError(message)
         if not self._unsafe:  # warn on becoming unsafe, not at every step while it stays so

@@ -22,8 +22,9 @@ _SAVED_GUARD_SETTINGS = ("safety", "strict", "iterations", "iterations_warm")
 
 def _guard_setting(name: str, doc: str) -> property:
     """A property that reads and writes the TimeStepGuard's attribute `name`."""
-    return property(lambda self: getattr(self.guard, name), lambda self, value: setattr(self.guard, name, value),
-                    doc=doc)
+    return property(
+        lambda self: getattr(self.guard, name), lambda self, value: setattr(self.guard, name, value), doc=doc
+    )
 
 
 class TimeStepLimits:
@@ -35,13 +36,17 @@ class TimeStepLimits:
         self.guard = TimeStepGuard()
 
     time_step_safety = _guard_setting(
-        "safety", "O.dt must stay below time_step_safety * critical_time_step (zeta of thesis 4.22); 0.8.")
+        "safety", "O.dt must stay below time_step_safety * critical_time_step (zeta of thesis 4.22); 0.8."
+    )
     strict_time_step = _guard_setting(
-        "strict", "True: an unsafe O.dt raises ValueError instead of warning (TimeStepWarning).")
+        "strict", "True: an unsafe O.dt raises ValueError instead of warning (TimeStepWarning)."
+    )
     collective_iterations = _guard_setting(
-        "iterations", "Operator applications at most for the collective limit of the first mesh (cold start); 40.")
+        "iterations", "Operator applications at most for the collective limit of the first mesh (cold start); 40."
+    )
     collective_iterations_warm = _guard_setting(
-        "iterations_warm", "Operator applications at most for the collective limit of a later mesh (warm start); 10.")
+        "iterations_warm", "Operator applications at most for the collective limit of a later mesh (warm start); 10."
+    )
 
     @property
     def viscous_time_step(self) -> float:
@@ -105,8 +110,9 @@ class TimeStepLimits:
         collective = float("inf")
         stepped = self._bodies.stepped
         if stepped is not None:  # the masses of the spheres the mesh holds
-            collective = self.guard.limit_to_check(self._core, stepped.masses, dt, min(dt_mv, scan.dt_dem),
-                                                   yade.O.iter, before_step)
+            collective = self.guard.limit_to_check(
+                self._core, stepped.masses, dt, min(dt_mv, scan.dt_dem), yade.O.iter, before_step
+            )
         self.guard.check(dt, dt_mv, collective, scan.dt_dem)
 
     def check_new_mesh(self, dt: float, scan: SceneScan) -> None:

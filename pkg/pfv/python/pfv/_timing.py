@@ -12,13 +12,24 @@ import time
 from typing import Any
 
 # Stages of the core's step and remesh (step_times() / remesh_times() keys) and their labels.
-_REMESH_STAGES = (("triangulation", "remesh: triangulation"), ("geometry", "remesh: pore geometry"),
-                  ("conductance", "remesh: conductances"), ("force_cache", "remesh: force cache"),
-                  ("shear_geometry", "remesh: shear pairs"), ("assembly", "system: assembly"),
-                  ("analysis", "system: ordering"), ("factorization", "system: factorization"),
-                  ("carry_over", "remesh: pressures carried over"))
-_STEP_STAGES = (("volumes", "dV/dt"), ("pressure_field", "boundary pressure"), ("solve", "solve"), ("forces", "forces"),
-                ("shear_forces", "shear forces"))
+_REMESH_STAGES = (
+    ("triangulation", "remesh: triangulation"),
+    ("geometry", "remesh: pore geometry"),
+    ("conductance", "remesh: conductances"),
+    ("force_cache", "remesh: force cache"),
+    ("shear_geometry", "remesh: shear pairs"),
+    ("assembly", "system: assembly"),
+    ("analysis", "system: ordering"),
+    ("factorization", "system: factorization"),
+    ("carry_over", "remesh: pressures carried over"),
+)
+_STEP_STAGES = (
+    ("volumes", "dV/dt"),
+    ("pressure_field", "boundary pressure"),
+    ("solve", "solve"),
+    ("forces", "forces"),
+    ("shear_forces", "shear forces"),
+)
 
 
 class StageTimings:

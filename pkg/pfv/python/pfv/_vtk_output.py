@@ -35,8 +35,14 @@ from typing import Any
 import numpy as np
 from vtkmodules.util.numpy_support import numpy_to_vtk
 from vtkmodules.vtkCommonCore import VTK_ID_TYPE, vtkPoints
-from vtkmodules.vtkCommonDataModel import (VTK_HEXAHEDRON, VTK_TETRA, VTK_VERTEX, VTK_WEDGE, vtkCellArray,
-                                           vtkUnstructuredGrid)
+from vtkmodules.vtkCommonDataModel import (
+    VTK_HEXAHEDRON,
+    VTK_TETRA,
+    VTK_VERTEX,
+    VTK_WEDGE,
+    vtkCellArray,
+    vtkUnstructuredGrid,
+)
 from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridWriter
 
 __all__ = ["FlowState", "read_state", "pore_grid", "sphere_grid", "write_grid", "save", "COLLECTION"]
@@ -53,18 +59,18 @@ class FlowState:
     """What the output needs of an engine, copied out under its lock (spheres in the core's order)."""
 
     time: float
-    ids: np.ndarray             # YADE ids of the spheres
+    ids: np.ndarray  # YADE ids of the spheres
     radii: np.ndarray
-    positions: np.ndarray       # (n, 3): the sphere centres of the last step
-    forces: np.ndarray          # (n + 6, 3): fluid forces on the spheres, then on the six walls
-    walls: np.ndarray           # the six wall coordinates (xmin, xmax, ymin, ymax, zmin, zmax)
-    wall_ids: np.ndarray        # YADE ids of the walls
-    cell_vertices: np.ndarray   # (cells, 4): vertex n + w is wall w
+    positions: np.ndarray  # (n, 3): the sphere centres of the last step
+    forces: np.ndarray  # (n + 6, 3): fluid forces on the spheres, then on the six walls
+    walls: np.ndarray  # the six wall coordinates (xmin, xmax, ymin, ymax, zmin, zmax)
+    wall_ids: np.ndarray  # YADE ids of the walls
+    cell_vertices: np.ndarray  # (cells, 4): vertex n + w is wall w
     pressure: np.ndarray
-    velocity: np.ndarray        # (cells, 3)
+    velocity: np.ndarray  # (cells, 3)
     fluid_volume: np.ndarray
-    volume: np.ndarray          # total volume at `positions`
-    source: np.ndarray          # wall w, 6 + imposed point k, or -1 (pressure solved for)
+    volume: np.ndarray  # total volume at `positions`
+    source: np.ndarray  # wall w, 6 + imposed point k, or -1 (pressure solved for)
 
     @property
     def n_spheres(self) -> int:
@@ -74,12 +80,21 @@ class FlowState:
 def read_state(core: Any, ids: np.ndarray, radii: np.ndarray, wall_ids: list[int], time: float) -> FlowState:
     """The output's data from the core `core` (pfv._core.Engine, after a step) for the spheres of YADE ids `ids` and
     radii `radii` (those of the last step) and the walls `wall_ids`. The caller holds the engine's lock."""
-    return FlowState(time=float(time), ids=np.asarray(ids, dtype=np.int64), radii=np.asarray(radii, dtype=float),
-                     positions=core.positions(), forces=core.forces(), walls=np.array(core.walls(), dtype=float),
-                     wall_ids=np.asarray(wall_ids, dtype=np.int64), cell_vertices=core.cell_vertices(),
-                     pressure=core.pressure(), velocity=core.cell_velocities(),
-                     fluid_volume=core.cell_fluid_volumes(), volume=core.current_cell_volumes(),
-                     source=core.cell_sources())
+    return FlowState(
+        time=float(time),
+        ids=np.asarray(ids, dtype=np.int64),
+        radii=np.asarray(radii, dtype=float),
+        positions=core.positions(),
+        forces=core.forces(),
+        walls=np.array(core.walls(), dtype=float),
+        wall_ids=np.asarray(wall_ids, dtype=np.int64),
+        cell_vertices=core.cell_vertices(),
+        pressure=core.pressure(),
+        velocity=core.cell_velocities(),
+        fluid_volume=core.cell_fluid_volumes(),
+        volume=core.current_cell_volumes(),
+        source=core.cell_sources(),
+    )
 
 
 # The VTK arrays are copies: a VTK array sharing a numpy array's memory keeps it alive only through its Python
@@ -95,8 +110,9 @@ def _id_array(values: np.ndarray) -> Any:
     return numpy_to_vtk(np.ascontiguousarray(values, dtype=np.int64), deep=True, array_type=VTK_ID_TYPE)
 
 
-def _grid(points: np.ndarray, cell_types: np.ndarray, offsets: np.ndarray, connectivity: np.ndarray,
-          time: float) -> vtkUnstructuredGrid:
+def _grid(
+    points: np.ndarray, cell_types: np.ndarray, offsets: np.ndarray, connectivity: np.ndarray, time: float
+) -> vtkUnstructuredGrid:
     grid = vtkUnstructuredGrid()
     vtk_points = vtkPoints()
     vtk_points.SetData(_vtk_array(np.asarray(points, dtype=float), "Points"))
@@ -184,12 +200,17 @@ def _pore_cells(state: FlowState, with_boundaries: bool) -> tuple[np.ndarray, ..
         axis1, axis2 = w1 // 2, w2 // 2
         edge = 3 - axis1 - axis2
         # Base (a, a on w1, a on w1 and w2, a on w2): its normal must point towards b.
-        toward = ((walls[w1] - a[i, axis1]) * (walls[w2] - a[i, axis2]) * _even(axis1, axis2)
-                  * (b[i, edge] - a[i, edge]))
+        toward = (walls[w1] - a[i, axis1]) * (walls[w2] - a[i, axis2]) * _even(axis1, axis2) * (b[i, edge] - a[i, edge])
         flip = toward < 0
         w1[flip], w2[flip] = w2[flip], w1[flip].copy()
-        blocks.append((rows, np.column_stack([s0, key(s0, w1), key(s0, w1, w2), key(s0, w2),
-                                              s1, key(s1, w1), key(s1, w1, w2), key(s1, w2)])))
+        blocks.append(
+            (
+                rows,
+                np.column_stack(
+                    [s0, key(s0, w1), key(s0, w1, w2), key(s0, w2), s1, key(s1, w1), key(s1, w1, w2), key(s1, w2)]
+                ),
+            )
+        )
 
     rows = np.flatnonzero(counts == 3)
     if len(rows):
@@ -199,13 +220,26 @@ def _pore_cells(state: FlowState, with_boundaries: bool) -> tuple[np.ndarray, ..
         i = np.arange(len(rows))
         axis1, axis2, axis3 = w1 // 2, w2 // 2, w3 // 2
         # Base (a, a on w1, a on w1 and w2, a on w2): its normal must point towards w3.
-        toward = ((walls[w1] - a[i, axis1]) * (walls[w2] - a[i, axis2]) * (walls[w3] - a[i, axis3])
-                  * _even(axis1, axis2))
+        toward = (walls[w1] - a[i, axis1]) * (walls[w2] - a[i, axis2]) * (walls[w3] - a[i, axis3]) * _even(axis1, axis2)
         flip = toward < 0
         w1[flip], w2[flip] = w2[flip], w1[flip].copy()
-        blocks.append((rows, np.column_stack([s0, key(s0, w1), key(s0, w1, w2), key(s0, w2),
-                                              key(s0, w3), key(s0, w1, w3), key(s0, w1, w2, w3),
-                                              key(s0, w2, w3)])))
+        blocks.append(
+            (
+                rows,
+                np.column_stack(
+                    [
+                        s0,
+                        key(s0, w1),
+                        key(s0, w1, w2),
+                        key(s0, w2),
+                        key(s0, w3),
+                        key(s0, w1, w3),
+                        key(s0, w1, w2, w3),
+                        key(s0, w2, w3),
+                    ]
+                ),
+            )
+        )
 
     points = pos
     if keys:
@@ -227,14 +261,16 @@ def pore_grid(state: FlowState, with_boundaries: bool) -> vtkUnstructuredGrid:
     source = np.asarray(state.source, dtype=np.int32)[kept]
     fictious = (np.asarray(state.cell_vertices) >= state.n_spheres).sum(axis=1).astype(np.int32)[kept]
     data = grid.GetCellData()
-    for name, values in (("Pressure", np.asarray(state.pressure, dtype=float)[kept]),
-                         ("Velocity", np.asarray(state.velocity, dtype=float)[kept]),
-                         ("Pcondition", (source >= 0).astype(np.int32)),
-                         ("PressureSource", source),
-                         ("FluidVolume", np.asarray(state.fluid_volume, dtype=float)[kept]),
-                         ("Volume", np.asarray(state.volume, dtype=float)[kept]),
-                         ("fictious", fictious),
-                         ("id", kept.astype(np.int32))):
+    for name, values in (
+        ("Pressure", np.asarray(state.pressure, dtype=float)[kept]),
+        ("Velocity", np.asarray(state.velocity, dtype=float)[kept]),
+        ("Pcondition", (source >= 0).astype(np.int32)),
+        ("PressureSource", source),
+        ("FluidVolume", np.asarray(state.fluid_volume, dtype=float)[kept]),
+        ("Volume", np.asarray(state.volume, dtype=float)[kept]),
+        ("fictious", fictious),
+        ("id", kept.astype(np.int32)),
+    ):
         data.AddArray(_vtk_array(values, name))
     data.SetActiveScalars("Pressure")
     return grid
@@ -244,8 +280,13 @@ def sphere_grid(state: FlowState) -> vtkUnstructuredGrid:
     """The coupled spheres as VTK vertices with their radii, YADE ids and fluid forces; the walls' ids, positions and
     fluid forces as field data."""
     n = state.n_spheres
-    grid = _grid(state.positions, np.full(n, VTK_VERTEX, dtype=np.uint8), np.arange(n + 1, dtype=np.int64),
-                 np.arange(n, dtype=np.int64), state.time)
+    grid = _grid(
+        state.positions,
+        np.full(n, VTK_VERTEX, dtype=np.uint8),
+        np.arange(n + 1, dtype=np.int64),
+        np.arange(n, dtype=np.int64),
+        state.time,
+    )
     forces = np.asarray(state.forces, dtype=float)
     data = grid.GetPointData()
     data.AddArray(_vtk_array(state.radii, "radii"))
@@ -255,7 +296,7 @@ def sphere_grid(state: FlowState) -> vtkUnstructuredGrid:
     field = grid.GetFieldData()
     field.AddArray(_vtk_array(state.wall_ids, "wallIds"))
     field.AddArray(_vtk_array(state.walls, "wallPositions"))
-    field.AddArray(_vtk_array(forces[n:n + _WALLS], "wallFluidForce"))
+    field.AddArray(_vtk_array(forces[n : n + _WALLS], "wallFluidForce"))
     return grid
 
 
@@ -295,13 +336,18 @@ _series_lock = threading.Lock()
 
 def _write_collection(folder: str, snapshots: list[_Snapshot]) -> None:
     """The folder's ParaView collection: every snapshot's parts at its time."""
-    root = ElementTree.Element("VTKFile", type="Collection", version="0.1",
-                               byte_order="LittleEndian" if sys.byteorder == "little" else "BigEndian")
+    root = ElementTree.Element(
+        "VTKFile",
+        type="Collection",
+        version="0.1",
+        byte_order="LittleEndian" if sys.byteorder == "little" else "BigEndian",
+    )
     collection = ElementTree.SubElement(root, "Collection")
     for snapshot in snapshots:
         for part, (name, file) in enumerate(snapshot.files):
-            ElementTree.SubElement(collection, "DataSet", timestep=repr(snapshot.time), group="", part=str(part),
-                                   name=name, file=file)
+            ElementTree.SubElement(
+                collection, "DataSet", timestep=repr(snapshot.time), group="", part=str(part), name=name, file=file
+            )
     tree = ElementTree.ElementTree(root)
     ElementTree.indent(tree)
     path = os.path.join(folder, COLLECTION)

@@ -21,7 +21,8 @@ def check(running: str, pinned: str = PINNED_YADE_VERSION) -> None:
         raise YadeVersionError(
             f"pfv is built for YADE {pinned} (it reads YADE's objects by their memory layout in that version), "
             f"but this is YADE {running}; rebuild PFV against this YADE after checking the layouts in "
-            "pkg/pfv/yade_bridge, or run YADE " + pinned)
+            "pkg/pfv/yade_bridge, or run YADE " + pinned
+        )
 
 
 def check_running_yade() -> None:

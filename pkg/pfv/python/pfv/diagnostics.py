@@ -41,13 +41,15 @@ def critical_gradient(porosity: float, rho_s: float, rho_f: float) -> float:
 @dataclass(frozen=True)
 class SensorGrid:
     """Pressure sensors on `verticals` vertical lines, `levels` heights each (the thesis' 5 x 6)."""
-    x: np.ndarray       # per vertical
-    z: np.ndarray       # per vertical
+
+    x: np.ndarray  # per vertical
+    z: np.ndarray  # per vertical
     heights: np.ndarray  # per level, increasing
 
     @classmethod
-    def in_box(cls, lo: Sequence[float], hi: Sequence[float], verticals: int = 5, levels: int = 6,
-               z: float | None = None) -> SensorGrid:
+    def in_box(
+        cls, lo: Sequence[float], hi: Sequence[float], verticals: int = 5, levels: int = 6, z: float | None = None
+    ) -> SensorGrid:
         """Verticals equally spaced in x across the box (away from the walls by half a spacing), at
         mid-depth in z unless given; levels equally spaced in y the same way."""
         lo, hi = np.asarray(lo, float), np.asarray(hi, float)
@@ -110,7 +112,7 @@ def porosity_below(radii: np.ndarray, area: float, height: float, bottom: float)
     volume = area * (height - bottom)
     if not volume > 0:
         raise ValueError("the packing's surface is not above its bottom")
-    return 1.0 - float(np.sum(4.0 / 3.0 * math.pi * radii ** 3)) / volume
+    return 1.0 - float(np.sum(4.0 / 3.0 * math.pi * radii**3)) / volume
 
 
 def kinetic_energy(vel: np.ndarray, mass: np.ndarray) -> float:
@@ -118,8 +120,9 @@ def kinetic_energy(vel: np.ndarray, mass: np.ndarray) -> float:
     return 0.5 * float(np.sum(mass * np.einsum("ij,ij->i", vel, vel)))
 
 
-def instability_onset(amplitude: Sequence[float], energy: Sequence[float], mass: float, d50: float,
-                      threshold: float, g: float = G) -> float:
+def instability_onset(
+    amplitude: Sequence[float], energy: Sequence[float], mass: float, d50: float, threshold: float, g: float = G
+) -> float:
     """The load amplitude at which a bed under a growing load starts to move (thesis 6.3 reads it
     off the jump of its kinetic-energy curve): the first record where the root-mean-square grain
     velocity sqrt(2 energy / mass) exceeds threshold * sqrt(g d50) after having been at or below it. A
@@ -129,8 +132,9 @@ def instability_onset(amplitude: Sequence[float], energy: Sequence[float], mass:
     a = np.asarray(amplitude, dtype=float)
     ke = np.asarray(energy, dtype=float)
     if a.ndim != 1 or a.shape != ke.shape:
-        raise ValueError(f"amplitude and energy must be two records of one length (got shapes "
-                         f"{a.shape} and {ke.shape})")
+        raise ValueError(
+            f"amplitude and energy must be two records of one length (got shapes " f"{a.shape} and {ke.shape})"
+        )
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(ke)) and np.all(ke >= 0)):
         raise ValueError("amplitude and energy must be finite, energy non-negative")
     for name, value in (("mass", mass), ("d50", d50), ("threshold", threshold), ("g", g)):
@@ -140,13 +144,21 @@ def instability_onset(amplitude: Sequence[float], energy: Sequence[float], mass:
     rest = np.flatnonzero(~moving)
     if not len(rest):
         return float("nan")
-    onset = np.flatnonzero(moving[rest[0]:])
+    onset = np.flatnonzero(moving[rest[0] :])
     return float(a[rest[0] + onset[0]]) if len(onset) else float("nan")
 
 
-def effective_stress_profile(stresses: Sequence[Any], ids: np.ndarray, pos: np.ndarray, radii: np.ndarray,
-                             bottom: float, top: float, bins: int, area: float,
-                             x_band: tuple[float, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+def effective_stress_profile(
+    stresses: Sequence[Any],
+    ids: np.ndarray,
+    pos: np.ndarray,
+    radii: np.ndarray,
+    bottom: float,
+    top: float,
+    bins: int,
+    area: float,
+    x_band: tuple[float, float] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Vertical effective stress sigma'_yy (compression positive) in horizontal slices: the sum over
     the slice's spheres of V_p sigma_p (thesis 2.18, YADE's bodyStressTensors: sigma_p = (1/V_p) sum of
     contact force x branch) over the slice volume. With x_band only the spheres whose centres lie in
@@ -159,7 +171,7 @@ def effective_stress_profile(stresses: Sequence[Any], ids: np.ndarray, pos: np.n
         keep = (pos[:, 0] >= x_band[0]) & (pos[:, 0] < x_band[1])
         span = pos[:, 0].max() - pos[:, 0].min()
         share = (x_band[1] - x_band[0]) / span if span > 0 else 1.0
-    volume = 4.0 / 3.0 * math.pi * radii ** 3
+    volume = 4.0 / 3.0 * math.pi * radii**3
     syy = np.array([-stresses[i][1, 1] for i in ids])  # YADE: tension positive
     which = np.digitize(pos[:, 1], edges) - 1
     out = np.zeros(bins)
@@ -174,8 +186,9 @@ def pressure_profile(flow: Any, x: float, z: float, heights: Sequence[float]) ->
     return np.array([flow.getPorePressure((x, float(y), z)) for y in heights])
 
 
-def horizontal_displacements(pos: np.ndarray, start: np.ndarray, x_axis: float, half_width: float
-                             ) -> tuple[np.ndarray, np.ndarray]:
+def horizontal_displacements(
+    pos: np.ndarray, start: np.ndarray, x_axis: float, half_width: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Heights and x-displacements (from `start`) of the spheres whose initial centres lie within
     half_width of the vertical x = x_axis (the thesis' symmetry axis), sorted by height."""
     on_axis = np.abs(start[:, 0] - x_axis) <= half_width
@@ -190,9 +203,20 @@ class Monitor:
     porosity below it, the kinetic energy and YADE's unbalanced force; prints progress (simulated
     time, wall time, estimated time left) every `report_every` records when t_end is known."""
 
-    def __init__(self, flow: Any, grid: SensorGrid, porosity0: float, rho_s: float, rho_f: float, area: float,
-                 bottom: float, amplitude: Callable[[float], float] | None = None, t_end: float | None = None,
-                 report_every: int = 10, g: float = G):
+    def __init__(
+        self,
+        flow: Any,
+        grid: SensorGrid,
+        porosity0: float,
+        rho_s: float,
+        rho_f: float,
+        area: float,
+        bottom: float,
+        amplitude: Callable[[float], float] | None = None,
+        t_end: float | None = None,
+        report_every: int = 10,
+        g: float = G,
+    ):
         self.flow, self.grid, self.area, self.bottom = flow, grid, area, bottom
         self.gamma_prime = buoyant_unit_weight(porosity0, rho_s, rho_f, g)
         self.i_c = critical_gradient(porosity0, rho_s, rho_f)
@@ -202,12 +226,19 @@ class Monitor:
 
     def __call__(self) -> None:
         from yade import O, plot, utils
+
         ids, pos, rad, vel, mass = sphere_arrays(O.bodies)
         p = self.grid.pressures(self.flow)
         ratios = self.grid.gradient_ratios(p, self.gamma_prime)
         top = top_height(pos, rad, 0.99)
-        data = dict(t=O.time, iter=O.iter, top=top, porosity=porosity_below(rad, self.area, top, self.bottom),
-                    KE=kinetic_energy(vel, mass), unbalanced=utils.unbalancedForce())
+        data = dict(
+            t=O.time,
+            iter=O.iter,
+            top=top,
+            porosity=porosity_below(rad, self.area, top, self.bottom),
+            KE=kinetic_energy(vel, mass),
+            unbalanced=utils.unbalancedForce(),
+        )
         if self.amplitude is not None:
             data["A"] = float(self.amplitude(O.time))
         for v in range(p.shape[0]):
@@ -222,16 +253,20 @@ class Monitor:
         elif self.t_end and self.records % self.report_every == 0:
             wall, done = time.monotonic() - self.t0[0], O.time - self.t0[1]
             left = wall * max(self.t_end - O.time, 0) / done if done > 0 else math.nan
-            print(f"t = {O.time:.4g} / {self.t_end:.4g} s simulated, {wall:.0f} s wall, about {left:.0f} s left",
-                  flush=True)
+            print(
+                f"t = {O.time:.4g} / {self.t_end:.4g} s simulated, {wall:.0f} s wall, about {left:.0f} s left",
+                flush=True,
+            )
 
 
 def save_plots(data: dict[str, Sequence[float]], path: str, i_c_threshold: float = 0.8) -> None:
     """PNG of a Monitor's record: gradient ratios per level (mean over the verticals) with the
     liquefaction threshold, pressures, top height and porosity, kinetic energy."""
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     t = np.asarray(data["t"])
     fig, ax = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     levels = sorted({int(k.split("_")[2]) for k in data if k.startswith("r_")})

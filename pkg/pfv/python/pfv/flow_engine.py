@@ -69,7 +69,8 @@ def _run(key: int) -> None:
             raise RuntimeError(
                 "this pfv.FlowEngine must be re-created: YADE restored it as a plain PyRunner and the "
                 "scene carries no saved state for it (saved before PFV could add it?); create a new "
-                "pfv.FlowEngine and put it back into O.engines")
+                "pfv.FlowEngine and put it back into O.engines"
+            )
     engine._step()
 
 
@@ -83,18 +84,49 @@ def _gravity(scene: Any) -> tuple[float, float, float]:
 
 # The core's settings saved with a scene: every one a user may set (YADE's names map onto most).
 # The upper clamp first: restoring must never meet a lower bound above the default upper one.
-_SAVED_CORE_SETTINGS = ("max_k_div_k_mean",) + tuple(sorted(
-    (set(attributes.CORE_NAME.values()) | {"solver", "ordering", "max_iterations", "reuse_ordering",
-                                           "cholmod_openmp_teams"}) - {"max_k_div_k_mean"}))
+_SAVED_CORE_SETTINGS = ("max_k_div_k_mean",) + tuple(
+    sorted(
+        (
+            set(attributes.CORE_NAME.values())
+            | {"solver", "ordering", "max_iterations", "reuse_ordering", "cholmod_openmp_teams"}
+        )
+        - {"max_k_div_k_mean"}
+    )
+)
 
 # The engine's own fields (plain instance attributes, not YADE attributes): the core, the engine's
 # key in the registry, its lock, its timings, ompThreads, and its parts.
-_FIELDS = frozenset({"_core", "_key", "_lock", "_timings", "_threads", "_warnings", "_history", "_bodies",
-                     "_time_step", "_loads", "_options", "_reports", "_kept", "_geometry", "_flow",
-                     "_conditions", "_outputs"})
+_FIELDS = frozenset(
+    {
+        "_core",
+        "_key",
+        "_lock",
+        "_timings",
+        "_threads",
+        "_warnings",
+        "_history",
+        "_bodies",
+        "_time_step",
+        "_loads",
+        "_options",
+        "_reports",
+        "_kept",
+        "_geometry",
+        "_flow",
+        "_conditions",
+        "_outputs",
+    }
+)
 # The parts saved with a scene, under these keys.
-_SAVED_PARTS = {"bodies": "_bodies", "loads": "_loads", "options": "_options", "reports": "_reports",
-                "kept": "_kept", "cells": "_geometry", "guard": "_time_step"}
+_SAVED_PARTS = {
+    "bodies": "_bodies",
+    "loads": "_loads",
+    "options": "_options",
+    "reports": "_reports",
+    "kept": "_kept",
+    "cells": "_geometry",
+    "guard": "_time_step",
+}
 
 
 class FlowEngine(PyRunner):
@@ -364,8 +396,9 @@ class FlowEngine(PyRunner):
         self._time_step.check(scene.dt, scan, before_step=True)
         return dt
 
-    def _advance(self, scene: Any, scan: SceneScan, pos: np.ndarray, walls: list[float], dt: float,
-                 remeshing: bool) -> None:
+    def _advance(
+        self, scene: Any, scan: SceneScan, pos: np.ndarray, walls: list[float], dt: float, remeshing: bool
+    ) -> None:
         """The core's step: remesh when due, dV/dt, solve, forces; with a load evaluated at this step's
         time, and blockHook between a new mesh and its linear system."""
         core = self._core
@@ -426,8 +459,11 @@ class FlowEngine(PyRunner):
         core = self._core
         running = self._bodies.has_mesh()
         if self._loads.boundary_pressure is not None and self._warnings.once("unsaved function"):
-            warnings.warn("pfv.FlowEngine: the function of set_boundary_pressure is not saved with the scene; "
-                          "set it again after O.load", stacklevel=3)
+            warnings.warn(
+                "pfv.FlowEngine: the function of set_boundary_pressure is not saved with the scene; "
+                "set it again after O.load",
+                stacklevel=3,
+            )
         last_step = self._history.last_step
         return {
             "core": {name: getattr(core, name) for name in _SAVED_CORE_SETTINGS},
@@ -484,6 +520,7 @@ class FlowEngine(PyRunner):
 # Names set as ordinary attributes: PyRunner's (command, iterPeriod, label, ...) and the properties
 # of FlowEngine (its own and those forwarded to its parts).
 _OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
-    name for klass in FlowEngine.__mro__ for name, v in vars(klass).items() if isinstance(v, property)}
+    name for klass in FlowEngine.__mro__ for name, v in vars(klass).items() if isinstance(v, property)
+}
 
 _persistence.install()  # O.save / O.load carry the engines' state

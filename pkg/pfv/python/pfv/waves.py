@@ -51,8 +51,9 @@ class HalfWave:
     time (sections 6.2-6.3). ``length`` is the half-wavelength L (the sample's length along x),
     ``origin`` the x where the load is largest (the xmin wall)."""
 
-    def __init__(self, amplitude: float = 0.0, length: float = 1.0, origin: float = 0.0, rate: float = 0.0,
-                 mean: float = 0.0) -> None:
+    def __init__(
+        self, amplitude: float = 0.0, length: float = 1.0, origin: float = 0.0, rate: float = 0.0, mean: float = 0.0
+    ) -> None:
         self.amplitude = _number("HalfWave", "amplitude", amplitude)
         self.length = _positive("HalfWave", "length", length)
         self.origin = _number("HalfWave", "origin", origin)
@@ -67,8 +68,10 @@ class HalfWave:
         return self.mean + self.amplitude_at(t) * (1.0 + np.cos((math.pi / self.length) * (x - self.origin)))
 
     def __repr__(self) -> str:
-        return (f"HalfWave(amplitude={self.amplitude!r}, length={self.length!r}, origin={self.origin!r}, "
-                f"rate={self.rate!r}, mean={self.mean!r})")
+        return (
+            f"HalfWave(amplitude={self.amplitude!r}, length={self.length!r}, origin={self.origin!r}, "
+            f"rate={self.rate!r}, mean={self.mean!r})"
+        )
 
 
 class StandingWave:
@@ -76,8 +79,9 @@ class StandingWave:
     thesis section 6.4, oscillating between +-amplitude with the given period, over the
     half-wavelength ``length``."""
 
-    def __init__(self, amplitude: float, period: float, length: float = 1.0, origin: float = 0.0,
-                 mean: float = 0.0) -> None:
+    def __init__(
+        self, amplitude: float, period: float, length: float = 1.0, origin: float = 0.0, mean: float = 0.0
+    ) -> None:
         self.amplitude = _number("StandingWave", "amplitude", amplitude)
         self.period = _positive("StandingWave", "period", period)
         self.length = _positive("StandingWave", "length", length)
@@ -92,5 +96,7 @@ class StandingWave:
         return self.mean + self.amplitude_at(t) * np.cos((math.pi / self.length) * (x - self.origin))
 
     def __repr__(self) -> str:
-        return (f"StandingWave(amplitude={self.amplitude!r}, period={self.period!r}, length={self.length!r}, "
-                f"origin={self.origin!r}, mean={self.mean!r})")
+        return (
+            f"StandingWave(amplitude={self.amplitude!r}, period={self.period!r}, length={self.length!r}, "
+            f"origin={self.origin!r}, mean={self.mean!r})"
+        )

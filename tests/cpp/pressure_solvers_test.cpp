@@ -121,10 +121,13 @@ TEST(PressureSolvers, RowsAndColumnsGiveTheSameResidual) {
 
 TEST(PressureSolvers, MultigridIsThereOnlyInABuildWithHypre) {
   EXPECT_EQ(solver_unavailable(SolverKind::kMultigrid).empty(), PFV_WITH_HYPRE != 0);
-  if (!PFV_WITH_HYPRE) EXPECT_NE(solver_unavailable(SolverKind::kMultigrid).find("without hypre"), std::string::npos);
+  if (!PFV_WITH_HYPRE) {
+    EXPECT_NE(solver_unavailable(SolverKind::kMultigrid).find("without hypre"), std::string::npos);
+  }
   for (SolverKind k :
-       {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient, SolverKind::kCholesky, SolverKind::kAuto})
+       {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient, SolverKind::kCholesky, SolverKind::kAuto}) {
     EXPECT_TRUE(solver_unavailable(k).empty()) << to_string(k);
+  }
 }
 
 }  // namespace

@@ -22,12 +22,13 @@ def check(what, ok, detail=""):
     return ok
 
 
-def expect_error(what, kind, fragment, action):
-    """`action` raises `kind` with `fragment` (case-insensitive) in its message."""
+def expect_error(what, kind, fragment, action, ignore_case=True):
+    """`action` raises `kind` with `fragment` in its message (ignoring case unless told not to)."""
     try:
         action()
     except kind as error:
-        if fragment.lower() not in str(error).lower():
+        message = str(error)
+        if not (fragment.lower() in message.lower() if ignore_case else fragment in message):
             fail(f"{what}: message lacks '{fragment}': {error}")
         else:
             print(f"ok   {what}: {type(error).__name__}: {str(error).splitlines()[-1][:120]}")

@@ -9,14 +9,14 @@ failures = []
 
 
 def fail(text):
-    print("FAIL " + text)
+    print("FAIL " + text, flush=True)
     failures.append(text)
 
 
 def check(what, ok, detail=""):
     """Record the check `what`; `detail` (measured values, tolerances) follows it on its line. Returns `ok`."""
     if ok:
-        print(f"ok   {what} {detail}")
+        print(f"ok   {what} {detail}", flush=True)
     else:
         fail(f"{what} {detail}")
     return ok

@@ -39,10 +39,6 @@ def expect_error(what, kind, fragment, action, ignore_case=True):
     fail(f"{what}: no error raised")
 
 
-def exit_code():
-    return 1 if failures else 0
-
-
 def report(name):
     """Print the summary of the `name` checks and exit 0 if all passed, 1 if any failed."""
     if failures:

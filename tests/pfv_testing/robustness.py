@@ -1,41 +1,11 @@
-"""Checks, expected errors and a summary shared by the YADE tests, and their usual scene: the 1000-sphere
-permeameter with a new pfv engine."""
+"""The usual scene of the robustness tests, the 1000-sphere permeameter with a new pfv engine, and the checks they
+share (pfv_testing.checks, re-exported here)."""
 import math
-import sys
 
 from pfv import FlowEngine
 from pfv_testing import scenes
+from pfv_testing.checks import check, expect_error, fail, failures, report  # noqa: F401 (re-exported)
 from yade import O
-
-failures = []
-
-
-def fail(text):
-    print("FAIL " + text)
-    failures.append(text)
-
-
-def check(what, ok, detail=""):
-    if ok:
-        print(f"ok   {what} {detail}")
-    else:
-        fail(f"{what} {detail}")
-
-
-def expect_error(what, kind, fragment, action):
-    """`action` raises `kind` with `fragment` (case-insensitive) in its message."""
-    try:
-        action()
-    except kind as error:
-        if fragment.lower() not in str(error).lower():
-            fail(f"{what}: message lacks '{fragment}': {error}")
-        else:
-            print(f"ok   {what}: {type(error).__name__}: {str(error).splitlines()[-1][:120]}")
-        return
-    except Exception as error:  # noqa: BLE001
-        fail(f"{what}: expected {kind.__name__}, got {type(error).__name__}: {error}")
-        return
-    fail(f"{what}: no error raised")
 
 
 def finish_iteration():
@@ -70,11 +40,3 @@ def conserved(flow, tol=1e-8):
     imbalance = sum(fluxes) + flow.core.volume_rate_total() - flow.core.imposed_flux_total()
     scale = max(abs(q) for q in fluxes)
     return all(map(math.isfinite, fluxes)) and abs(imbalance) <= tol * scale, (scale, imbalance)
-
-
-def report(name):
-    if failures:
-        print(f"{len(failures)} {name} checks failed")
-        sys.exit(1)
-    print(f"all {name} checks passed")
-    sys.exit(0)

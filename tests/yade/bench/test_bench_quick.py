@@ -20,7 +20,7 @@ import subprocess
 import sys
 import tempfile
 
-from pfv_testing import paths
+from pfv_testing import checks, paths
 
 
 def _here():
@@ -38,13 +38,13 @@ def _positive(x):
     return isinstance(x, (int, float)) and math.isfinite(x) and x > 0
 
 
-def _check_report(out, check):
+def _check_report(out):
     """The Markdown report: between its markers, a timing table with a row of times for both engines."""
     md = open(out).read() if os.path.exists(out) else ''
-    check('flow_benchmark output' in md, 'report written between markers')
+    checks.check('report written between markers', 'flow_benchmark output' in md)
     lines = md.splitlines()
     head = next((i for i, line in enumerate(lines) if 'remesh YADE' in line and 'remesh PFV' in line), None)
-    check(head is not None, 'timing table has YADE and PFV columns')
+    checks.check('timing table has YADE and PFV columns', head is not None)
     rows = []
     if head is not None:
         for line in lines[head + 2 :]:
@@ -52,68 +52,61 @@ def _check_report(out, check):
                 break
             rows.append(line)
     rows = [line for line in rows if line.startswith('| %d |' % QUICK_SIZE)]
-    check(len(rows) >= 1, 'timing table has a row for N=%d' % QUICK_SIZE)
+    checks.check('timing table has a row for N=%d' % QUICK_SIZE, len(rows) >= 1)
     if rows:
         cells = [c.strip() for c in rows[0].strip('|').split('|')]
-        check(sum(1 for c in cells if c.endswith(' ms') or c.endswith(' s')) >= 6, 'row has times for both engines')
+        checks.check(
+            'row has times for both engines', sum(1 for c in cells if c.endswith(' ms') or c.endswith(' s')) >= 6
+        )
 
 
-def _check_timings(row, check):
+def _check_timings(row):
     """The summary's times, cells, PFV breakdown and pressure comparison at the quick size."""
     for kind in ('yade', 'pfv'):
         e = row.get(kind, {})
         for what in ('remesh', 'flow', 'coupled', 'first'):
-            check(_positive(e.get(what)), '%s %s time positive and finite' % (kind, what))
-        check(isinstance(e.get('cells'), int) and e['cells'] > 0, '%s reports a number of cells' % kind)
-    check(_positive(row.get('dry')), 'dry step time positive and finite')
+            checks.check('%s %s time positive and finite' % (kind, what), _positive(e.get(what)))
+        checks.check('%s reports a number of cells' % kind, isinstance(e.get('cells'), int) and e['cells'] > 0)
+    checks.check('dry step time positive and finite', _positive(row.get('dry')))
     br = row.get('pfv_breakdown', {})
     for stage in ('triangulation', 'geometry', 'factorization', 'force_cache'):
-        check(_positive(br.get('remesh', {}).get(stage)), 'PFV remesh breakdown has %s' % stage)
+        checks.check('PFV remesh breakdown has %s' % stage, _positive(br.get('remesh', {}).get(stage)))
     for stage in ('solve', 'python + exchange'):
-        check(stage in br.get('steady', {}), 'PFV steady breakdown has %s' % stage)
+        checks.check('PFV steady breakdown has %s' % stage, stage in br.get('steady', {}))
     a = row.get('agreement', {})
-    check(isinstance(a.get('max_dp'), float) and math.isfinite(a['max_dp']), 'pressure comparison computed')
+    checks.check('pressure comparison computed', isinstance(a.get('max_dp'), float) and math.isfinite(a['max_dp']))
     print('  (info) probe pressures: max |dp|/dp = %s, Qin rel. diff = %s' % (a.get('max_dp'), a.get('flux_in_rel')))
 
 
-def _check_json(js, check):
+def _check_json(js):
     """The raw data: timings, memory and the oedometer."""
     data = json.load(open(js)) if os.path.exists(js) else {}
     summ = data.get('summary', {})
     t = next(iter(summ.values()), {})
-    _check_timings(t.get('sizes', {}).get(str(QUICK_SIZE), {}), check)
+    _check_timings(t.get('sizes', {}).get(str(QUICK_SIZE), {}))
     mem = data.get('memory', {}).get(str(QUICK_SIZE), {})
     for kind in ('dry', 'yade', 'pfv'):
         m = mem.get(kind, {})
-        check(_positive(m.get('peak_kb')) and _positive(m.get('rss_before_kb')), 'memory figures for %s' % kind)
+        checks.check('memory figures for %s' % kind, _positive(m.get('peak_kb')) and _positive(m.get('rss_before_kb')))
     oe = next(iter(t.get('oedometer', {}).values()), {})
     for kind in ('yade', 'pfv'):
-        check(_positive(oe.get(kind, {}).get('ratio')), 'oedometer coupled/dry ratio for %s' % kind)
+        checks.check('oedometer coupled/dry ratio for %s' % kind, _positive(oe.get(kind, {}).get('ratio')))
 
 
 def main():
     exe = shutil.which('yade-double') or 'yade-double'
-    failures = []
-
-    def check(ok, what):
-        print('%-70s %s' % (what, 'ok' if ok else 'FAIL'), flush=True)
-        if not ok:
-            failures.append(what)
-
     with tempfile.TemporaryDirectory(prefix='pfv-bench-quick-') as d:
         out, js = os.path.join(d, 'bench.md'), os.path.join(d, 'bench.json')
         cmd = [exe, '-n', '-x', BENCH, '--quick', '--out=' + out, '--json=' + js]
         print('running:', ' '.join(cmd), flush=True)
         r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
         print('\n'.join(line for line in r.stdout.splitlines() if line.startswith(('bench:', '  [')))[-4000:])
-        check(r.returncode == 0, 'benchmark exit code 0 (got %d)' % r.returncode)
+        checks.check('benchmark exit code 0 (got %d)' % r.returncode, r.returncode == 0)
         if r.returncode != 0:
             print(r.stdout[-4000:], r.stderr[-2000:])
-            return 1
-        _check_report(out, check)
-        _check_json(js, check)
-    print('\n%d failed' % len(failures))
-    return 1 if failures else 0
+            return
+        _check_report(out)
+        _check_json(js)
 
 
 def test_bench_quick():
@@ -131,7 +124,8 @@ def test_bench_quick():
 
 
 if __name__ == '__main__' and 'yade' in sys.modules:
-    sys.exit(main())
+    main()
+    checks.report('bench quick')
 elif __name__ == '__main__':
     print('run me with: yade-double -n -x %s' % sys.argv[0])
     sys.exit(2)

@@ -15,17 +15,10 @@ import subprocess
 import sys
 import tempfile
 
-from pfv_testing import paths
+from pfv_testing import checks, paths
 
 HERE = os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].endswith(".py") else __file__))
 BENCH = paths.BENCH
-failures = []
-
-
-def check(what, ok, detail=""):
-    print(("ok   " if ok else "FAIL ") + what + (f" {detail}" if detail else ""))
-    if not ok:
-        failures.append(what)
 
 
 def positive(x):
@@ -49,11 +42,11 @@ with tempfile.TemporaryDirectory(prefix="pfv-growth-") as work:
         text=True,
         timeout=1200,
     )
-    check("growth.py --quick exits with 0", run.returncode == 0, (run.stdout + run.stderr)[-800:])
+    checks.check("growth.py --quick exits with 0", run.returncode == 0, (run.stdout + run.stderr)[-800:])
     if run.returncode == 0:
         with open(data) as f:
             measured = json.load(f)
-        check("no child failed", not any(c.get("failed") for c in measured["timing"] + measured["memory"]))
+        checks.check("no child failed", not any(c.get("failed") for c in measured["timing"] + measured["memory"]))
         # The report's main table: | N | engine | first | remesh | flow | dry | coupled/dry | peak | solver |
         text = open(report).read()
         rows = {}
@@ -64,27 +57,26 @@ with tempfile.TemporaryDirectory(prefix="pfv-growth-") as work:
                 rows[(int(digits), cells[1])] = cells
         expected = {(n, k) for n in (3000, 6000) for k in ("yade", "pfv", "pfv-multigrid")}
         expected |= {(12000, "pfv"), (12000, "pfv-multigrid")}
-        check("one row per size and engine", set(rows) == expected, str(sorted(rows)))
+        checks.check("one row per size and engine", set(rows) == expected, str(sorted(rows)))
         for (n, kind), cells in sorted(rows.items()):
             numbers = [float(c) for c in (cells[2], cells[3], cells[5], cells[7])]  # first, remesh, dry, peak
-            check(
+            checks.check(
                 f"N={n} {kind}: positive first step, remesh, dry step and peak RSS",
                 all(map(positive, numbers)),
                 str(cells),
             )
             ratio, spread = cells[6].split(" ", 1)
             low, high = (float(x) for x in spread.strip("()").split("\u2013"))
-            check(
+            checks.check(
                 f"N={n} {kind}: coupled / dry, the median of the blocks, within their range",
                 0 < low <= float(ratio) <= high,
                 cells[6],
             )
             if kind == "pfv":
-                check(f"N={n} pfv: auto chose CHOLMOD", cells[8].startswith("cholesky"), cells[8])
+                checks.check(f"N={n} pfv: auto chose CHOLMOD", cells[8].startswith("cholesky"), cells[8])
             if kind == "pfv-multigrid":
-                check(f"N={n} pfv-multigrid: multigrid", cells[8].startswith("multigrid"), cells[8])
-        check("report has the ratio table", "PFV / YADE:" in text)
-        check("report has the fitted exponents", "Fitted exponents" in text)
-        check("figure written", os.path.exists(png) and os.path.getsize(png) > 0)
-print(f"{len(failures)} growth checks failed" if failures else "all growth checks passed")
-sys.exit(1 if failures else 0)
+                checks.check(f"N={n} pfv-multigrid: multigrid", cells[8].startswith("multigrid"), cells[8])
+        checks.check("report has the ratio table", "PFV / YADE:" in text)
+        checks.check("report has the fitted exponents", "Fitted exponents" in text)
+        checks.check("figure written", os.path.exists(png) and os.path.getsize(png) > 0)
+checks.report("growth")

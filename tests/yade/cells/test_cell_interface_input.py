@@ -9,19 +9,12 @@ conditions set on cells.
 import contextlib
 import io
 import os
-import sys
 import tempfile
 
 import numpy as np  # noqa: E402
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from yade import O  # noqa: E402
 import pfv  # noqa: E402
-
-results = []
-
-
-def check(name, ok, detail=""):
-    results.append((name, bool(ok), detail))
 
 
 def raises(kind, call):
@@ -63,8 +56,8 @@ def before_first_step():
         "cholmodStats": flow.cholmodStats,
     }
     bad = [name for name, call in calls.items() if not raises(RuntimeError, call)]
-    check("before the first step every cell member raises RuntimeError", not bad, ", ".join(bad))
-    check("porosity and epsVolMax read 0 before the first step", flow.porosity == 0 and flow.epsVolMax == 0)
+    checks.check("before the first step every cell member raises RuntimeError", not bad, ", ".join(bad))
+    checks.check("porosity and epsVolMax read 0 before the first step", flow.porosity == 0 and flow.epsVolMax == 0)
 
 
 def bad_arguments():
@@ -99,10 +92,10 @@ def bad_arguments():
         (ValueError, lambda: setattr(flow, "boundaryVelocity", [(0, 0, 0)] * 5)),
     ]
     bad = [i for i, (kind, call) in enumerate(cases) if not raises(kind, call)]
-    check("bad arguments raise the error that names them", not bad, f"cases {bad}")
+    checks.check("bad arguments raise the error that names them", not bad, f"cases {bad}")
     before = flow.getBoundaryFlux(3)
     O.run(1, True)
-    check(
+    checks.check(
         "the engine still runs, unchanged, after the refused calls",
         abs(flow.getBoundaryFlux(3) - before) <= 1e-12 * abs(before),
     )
@@ -133,13 +126,13 @@ def attributes_and_reports():
     back["boundaryVelocity"] = [tuple(v) for v in back["boundaryVelocity"]]
     values["boundaryVelocity"] = [tuple(float(x) for x in v) for v in values["boundaryVelocity"]]
     wrong = [name for name in values if back[name] != values[name]]
-    check("YADE's attributes are accepted and read back", not wrong, ", ".join(wrong))
-    check("meanK_opt is clampKValues", flow.clampKValues is False)
+    checks.check("YADE's attributes are accepted and read back", not wrong, ", ".join(wrong))
+    checks.check("meanK_opt is clampKValues", flow.clampKValues is False)
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         O.run(2, True)
     text = out.getvalue()
-    check(
+    checks.check(
         "debug, getCHOLMODPerfTimings and meanKStat report",
         "pfv.FlowEngine: iter" in text and "CHOLMOD Time to factorize" in text and "meanKStat (pfv)" in text,
         text[:200].replace("\n", " | "),
@@ -153,14 +146,14 @@ def attributes_and_reports():
     flow.resetLinearSystem()
     builds = flow.core.system_builds
     O.run(1, True)
-    check(
+    checks.check(
         "resetLinearSystem rebuilds the system, results unchanged",
         flow.core.system_builds == builds + 1 and abs(flow.getBoundaryFlux(3) - q) <= 1e-12 * abs(q),
     )
     flow.updateVolumes()
     flow.initializeVolumes()
     O.run(1, True)
-    check(
+    checks.check(
         "updateVolumes/initializeVolumes on a frozen packing change nothing",
         abs(flow.getBoundaryFlux(3) - q) <= 1e-12 * abs(q) and flow.epsVolMax == 0,
     )
@@ -176,7 +169,7 @@ def conditions_and_remesh():
     held = flow.getCellPImposed(c)
     flow.updateTriangulation = True
     O.run(1, True)
-    check(
+    checks.check(
         "conditions set on cells hold until the next remesh",
         held
         and not flow.getCellPImposed(flow.getCell(0.5, 0.5, 0.5))
@@ -190,7 +183,7 @@ def conditions_and_remesh():
     flow.updateTriangulation = True
     O.run(1, True)
     b = flow.getCell(0.3, 0.3, 0.3)
-    check(
+    checks.check(
         "doInterpolate: a blocked cell stays blocked across a remesh",
         flow.core.cell_blocked(b) and flow.getCellPressure(b) == 0,
     )
@@ -200,7 +193,7 @@ def conditions_and_remesh():
     O.run(2, True)
     flow.pressureForce = True
     O.run(1, True)
-    check("pressureForce=False runs no flow step", flow.core.remesh_count == remeshes)
+    checks.check("pressureForce=False runs no flow step", flow.core.remesh_count == remeshes)
 
 
 def velocities_follow_the_pressures():
@@ -210,17 +203,19 @@ def velocities_follow_the_pressures():
     O.run(1, True)
     point = (0.5, 0.5, 0.5)
     first = flow.getCellVelocity(point)
-    check("a second query on the same step gives the same velocity", flow.getCellVelocity(point) == first)
+    checks.check("a second query on the same step gives the same velocity", flow.getCellVelocity(point) == first)
     c = flow.getCell(*point)
     flow.setCellPressure(flow.getNeighbors(c)[0], 5.0)  # a neighbour's pressure drives the cell's flow
     changed = flow.getCellVelocity(point)
-    check("setCellPressure between steps changes the velocity at once", changed != first, f"{first} -> {changed}")
+    checks.check(
+        "setCellPressure between steps changes the velocity at once", changed != first, f"{first} -> {changed}"
+    )
     flow.setCellPImposed(flow.getNeighbors(c)[0], True)
     O.run(1, True)
     stepped = flow.getCellVelocity(point)
-    check("the next step's velocity is the new pressures'", stepped != changed and stepped != first)
+    checks.check("the next step's velocity is the new pressures'", stepped != changed and stepped != first)
     lengths = [len(flow.getCellVelocity(flow.getCellBarycenter(k))) for k in range(flow.nCells())]
-    check("every cell answers from the shared evaluation", set(lengths) == {3})
+    checks.check("every cell answers from the shared evaluation", set(lengths) == {3})
 
 
 def clumps():
@@ -238,7 +233,7 @@ def clumps():
     q_clump, cells = flow.getBoundaryFlux(3), flow.nCells()
     plain = engine()
     O.run(1, True)
-    check(
+    checks.check(
         "convertClumps=False: clump members coupled as spheres",
         cells == plain.nCells() and abs(q_clump - plain.getBoundaryFlux(3)) <= 1e-9 * abs(q_clump),
         f"{cells} {plain.nCells()}",
@@ -246,7 +241,7 @@ def clumps():
     flow = engine()
     O.bodies.clump([a, b])
     O.run(1, True)
-    check(
+    checks.check(
         "convertClumps=True: the clump is one vertex fewer than its members",
         flow.nCells() > 0 and len(flow._bodies.stepped.ids) == len(plain._bodies.stepped.ids) - 1,
     )
@@ -260,12 +255,7 @@ def main():
     conditions_and_remesh()
     velocities_follow_the_pressures()
     clumps()
-    failed = 0
-    for name, ok, detail in results:
-        failed += not ok
-        print(f"{'ok  ' if ok else 'FAIL'} {name}" + (f"  [{detail}]" if detail else ""))
-    print(f"{len(results) - failed}/{len(results)} checks passed")
-    return 1 if failed else 0
 
 
-sys.exit(main())
+main()
+checks.report("cell interface input")

@@ -12,11 +12,10 @@ references, wall cells (YADE's fictitious spheres), YADE's running means in pres
     yade-double -n -x tests/yade/cells/test_cell_interface_vs_yade.py      (exit 0 = pass)
 """
 import os
-import sys
 import tempfile
 
 import numpy as np  # noqa: E402
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from yade import O  # noqa: E402
 from yade.wrapper import FlowEngine as YadeFlowEngine  # noqa: E402
 import pfv  # noqa: E402
@@ -24,11 +23,6 @@ import pfv  # noqa: E402
 ENGINES = {"yade": YadeFlowEngine, "pfv": pfv.FlowEngine}
 PROBES = scenes.probe_points((1, 1, 1), 4, margin=0.2)  # 64 points away from the walls
 CENTRE = np.array((0.5, 0.5, 0.5))
-results = []  # (name, ok, detail)
-
-
-def check(name, ok, detail=""):
-    results.append((name, bool(ok), detail))
 
 
 def permeameter(kind, **extra):
@@ -123,56 +117,56 @@ def scene_a(kind):
 
 
 def compare_a(y, m):
-    check("nCells equal", y["n"] == m["n"], f"{y['n']} {m['n']}")
+    checks.check("nCells equal", y["n"] == m["n"], f"{y['n']} {m['n']}")
     same = [set(a["verts"]) == set(b["verts"]) for a, b in zip(y["rows"], m["rows"])]
-    check("the probe cells are the same tetrahedra", all(same), f"{sum(same)}/{len(same)}")
+    checks.check("the probe cells are the same tetrahedra", all(same), f"{sum(same)}/{len(same)}")
     pairs = [(a, b) for a, b, s in zip(y["rows"], m["rows"], same) if s]
-    check(
+    checks.check(
         "getCellBarycenter equal (interior cells)", max(np.linalg.norm(a["bary"] - b["bary"]) for a, b in pairs) < 1e-12
     )
-    check("getCellInvVoidVolume equal (iniVoidVolumes)", max(rel(a["inv"], b["inv"]) for a, b in pairs) < 1e-9)
-    check(
+    checks.check("getCellInvVoidVolume equal (iniVoidVolumes)", max(rel(a["inv"], b["inv"]) for a, b in pairs) < 1e-9)
+    checks.check(
         "getCellPImposed false inside, true at a pressure wall",
         not any(a["imposed"] or b["imposed"] for a, b in pairs) and y["near_ymin"] and m["near_ymin"],
     )
-    check("getNeighbors: the same neighbour cells", all(a["nb"] == b["nb"] for a, b in pairs))
-    check("isCellNeighbor agrees with getNeighbors", all(a["isnb"] and b["isnb"] for a, b in pairs))
+    checks.check("getNeighbors: the same neighbour cells", all(a["nb"] == b["nb"] for a, b in pairs))
+    checks.check("isCellNeighbor agrees with getNeighbors", all(a["isnb"] and b["isnb"] for a, b in pairs))
     k = [rel(a["k"][v], b["k"][v]) for a, b in pairs for v in a["verts"]]
     share = np.mean(np.array(k) < 1e-9)
-    check(
+    checks.check(
         "getConductivity: most throats equal (the others: dual edge missing the facet)",
         share > 0.8 and np.median(k) < 1e-12,
         f"{share:.2f} equal to 1e-9, max rel diff {max(k):.2g}",
     )
     dif = [rel(a["dif"][v], b["dif"][v]) for a, b in pairs for v in a["verts"]]
-    check("getDiffusionCoeff equal", max(dif) < 1e-9, f"max rel diff {max(dif):.2g}")
+    checks.check("getDiffusionCoeff equal", max(dif) < 1e-9, f"max rel diff {max(dif):.2g}")
     sol = [(a["sol"][v], b["sol"][v]) for a, b in pairs for v in a["verts"]]
     agree = [rel(s, t) < 1e-9 for s, t in sol]
     # Where they differ the cell's centre lies beyond the facet: PFV's half throat is empty.
-    check(
+    checks.check(
         "surfaceSolidThroatInPore equal, or 0 where the half throat lies outside the cell",
         all(ok or t == 0 for ok, (s, t) in zip(agree, sol)) and np.mean(agree) > 0.8,
         f"{np.mean(agree):.2f} equal",
     )
     vel = [np.linalg.norm(a["vel"] - b["vel"]) / np.linalg.norm(a["vel"]) for a, b in pairs]
-    check("getCellVelocity: the median cell within 2 %", np.median(vel) < 0.02, f"median {np.median(vel):.3g}")
-    check(
+    checks.check("getCellVelocity: the median cell within 2 %", np.median(vel) < 0.02, f"median {np.median(vel):.3g}")
+    checks.check(
         "averageVelocity: Darcy velocity within 0.5 % (the engines' fluxes differ by 0.2 %)",
         rel(y["avg"][1], m["avg"][1]) < 5e-3
         and abs(m["avg"][0]) < 1e-2 * m["avg"][1]
         and abs(m["avg"][2]) < 1e-2 * m["avg"][1],
         f"{y['avg']} {m['avg']}",
     )
-    check(
+    checks.check(
         "averageVelocity of PFV is flux / cross-section (unit box)",
         rel(m["avg"][1], m["q"]) < 1e-9,
         f"{m['avg'][1]} {m['q']}",
     )
     sph = [np.linalg.norm(a - b) / np.linalg.norm(a) for a, b in zip(y["sph"], m["sph"])]
-    check("avFlVelOnSph within 5 %", max(sph) < 0.05, f"{max(sph):.3g}")
-    check("getIncidentCells: the same cells around interior spheres", y["inc"] == m["inc"])
-    check("getBoundaryFluidArea equal", max(rel(a, b) for a, b in zip(y["area"], m["area"])) < 1e-9)
-    check(
+    checks.check("avFlVelOnSph within 5 %", max(sph) < 0.05, f"{max(sph):.3g}")
+    checks.check("getIncidentCells: the same cells around interior spheres", y["inc"] == m["inc"])
+    checks.check("getBoundaryFluidArea equal", max(rel(a, b) for a, b in zip(y["area"], m["area"])) < 1e-9)
+    checks.check(
         "getBoundaryVel: the same throats and areas",
         all(
             len(a) == len(b) and rel(sum(r[3] for r in a), sum(r[3] for r in b)) < 1e-9
@@ -180,48 +174,50 @@ def compare_a(y, m):
         ),
     )
     for kind, d in (("yade", y), ("pfv", m)):
-        check(f"getBoundaryVolume = -getBoundaryFlux dt ({kind})", rel(d["bvol"][0], -d["bvol"][1] * 2e-3) < 1e-12)
-    check("getConstrictions: as many throats", len(y["cons_all"]) == len(m["cons_all"]))
+        checks.check(
+            f"getBoundaryVolume = -getBoundaryFlux dt ({kind})", rel(d["bvol"][0], -d["bvol"][1] * 2e-3) < 1e-12
+        )
+    checks.check("getConstrictions: as many throats", len(y["cons_all"]) == len(m["cons_all"]))
     inner = m["cons_in"]
     # YADE's interior list also holds wall throats (its test of the vertices skips the first one):
     # every PFV interior radius is in YADE's list.
     found = np.abs(y["cons_in"][np.clip(np.searchsorted(y["cons_in"], inner), 0, len(y["cons_in"]) - 1)] - inner)
     found = np.minimum(found, np.abs(y["cons_in"][np.clip(np.searchsorted(y["cons_in"], inner) - 1, 0, None)] - inner))
-    check(
+    checks.check(
         "getConstrictions(False): every radius between spheres also YADE's",
         np.all(found < 1e-12 * inner.max()),
         f"{len(inner)} vs YADE's {len(y['cons_in'])}",
     )
-    check(
+    checks.check(
         "getConstrictions: wall throats negative, the same count",
         np.sum(m["cons_all"] < 0) == len(m["cons_all"]) - len(inner),
     )
     full = m["cons_full"]
-    check("getConstrictionsFull rows [cell1, cell2, r, nx, ny, nz]", all(len(r) == 6 for r in full))
-    check(
+    checks.check("getConstrictionsFull rows [cell1, cell2, r, nx, ny, nz]", all(len(r) == 6 for r in full))
+    checks.check(
         "volume: power cells equal inside (1e-9), within 1e-3 at the walls",
         np.median(np.abs(y["vol"] - m["vol"]) / y["vol"]) < 1e-9
         and np.max(np.abs(y["vol"] - m["vol"]) / y["vol"]) < 1e-3,
         f"max rel diff {np.max(np.abs(y['vol'] - m['vol']) / y['vol']):.2g}",
     )
-    check("volume: PFV's power cells fill the box", abs(m["vol"].sum() - 1.0) < 1e-12, f"{m['vol'].sum()!r}")
-    check("volume of a wall is 0", y["vol_wall"] == 0 and m["vol_wall"] == 0)
+    checks.check("volume: PFV's power cells fill the box", abs(m["vol"].sum() - 1.0) < 1e-12, f"{m['vol'].sum()!r}")
+    checks.check("volume of a wall is 0", y["vol_wall"] == 0 and m["vol_wall"] == 0)
     # YADE writes running means over the levels: undo them.
     running = np.array(y["profile"])
     levels = running * np.arange(1, 7) - np.concatenate(([0], running[:-1] * np.arange(1, 6)))
-    check(
+    checks.check(
         "pressureProfile: per-level means within 0.01 of YADE's",
         np.max(np.abs(levels - m["profile"])) < 0.01,
         f"{np.round(levels, 4)} {m['profile']}",
     )
     same_lines = np.mean([a == b for a, b in zip(y["vertices"][7:], m["vertices"][7:])])
-    check(
+    checks.check(
         "printVertices: header and sphere lines as YADE's",
         y["vertices"][0] == m["vertices"][0] and len(y["vertices"]) == len(m["vertices"]) and same_lines > 0.999,
         f"{same_lines:.4f} of the lines equal",
     )
     ty, tm = y["triplets"], m["triplets"]
-    check(
+    checks.check(
         "exportTriplets: as many unknowns and entries, lower triangle",
         ty.shape == tm.shape and ty[:, 0].max() == tm[:, 0].max() and np.all(tm[:, 0] >= tm[:, 1]),
     )
@@ -233,7 +229,7 @@ def compare_a(y, m):
     off = r != c
     np.add.at(gp, c[off], v[off] * p[r[off]])  # the upper triangle
     residual = np.abs(gp - m["unknown_b"]).max() / np.abs(m["unknown_b"]).max()
-    check("exportTriplets: G p = b for the solved pressures (6 digits)", residual < 1e-4, f"{residual:.2g}")
+    checks.check("exportTriplets: G p = b for the solved pressures (6 digits)", residual < 1e-4, f"{residual:.2g}")
     my, mm = y["matrix"], m["matrix"]
     layout = [len(my) == len(mm)] + [a == b for a, b in ((my[0], mm[0]), (my[2], mm[2]), (my[3], mm[3]))]
     dense_ok = True
@@ -243,11 +239,11 @@ def compare_a(y, m):
         expected[c[r == row]] = v[r == row]
         dense_ok &= len(values) == n and np.array_equal(values, expected)
     pointers = np.array([int(x) for x in mm[4].split()[:-1]])
-    check(
+    checks.check(
         "exportMatrix: YADE's layout; pointers, entries and dense rows of the lower triangle",
         all(layout) and dense_ok and len(pointers) == n and pointers[-1] == len(tm) - 1 and mm[1].count("(") == len(tm),
     )
-    check(
+    checks.check(
         "porosity within 1 % (away from the walls)",
         rel(y["porosity"], m["porosity"]) < 0.01,
         f"{y['porosity']:.5g} {m['porosity']:.5g}",
@@ -282,25 +278,29 @@ def scene_b(kind):
 
 
 def compare_b(y, m):
-    check("setCellPressure + setCellPImposed: the cell holds it", y["pc"] == 0.3 and m["pc"] == 0.3 and m["imposed"])
-    check("imposePressureFromId holds the pressure", abs(y["pd"] - 0.95) < 1e-12 and abs(m["pd"] - 0.95) < 1e-12)
-    check("probe pressures within 0.01", np.abs(y["p"] - m["p"]).max() < 0.01, f"{np.abs(y['p'] - m['p']).max():.3g}")
-    check(
+    checks.check(
+        "setCellPressure + setCellPImposed: the cell holds it", y["pc"] == 0.3 and m["pc"] == 0.3 and m["imposed"]
+    )
+    checks.check("imposePressureFromId holds the pressure", abs(y["pd"] - 0.95) < 1e-12 and abs(m["pd"] - 0.95) < 1e-12)
+    checks.check(
+        "probe pressures within 0.01", np.abs(y["p"] - m["p"]).max() < 0.01, f"{np.abs(y['p'] - m['p']).max():.3g}"
+    )
+    checks.check(
         "getCellFluxFromId of the imposed cell within 5 %",
         rel(y["flux_c"], m["flux_c"]) < 0.05,
         f"{y['flux_c']:.4g} {m['flux_c']:.4g}",
     )
-    check(
+    checks.check(
         "getCellFlux(cond) within 5 %, = getCellFluxFromId",
         rel(y["flux_d"], m["flux_d"]) < 0.05 and m["flux_d"] == m["flux_d_id"] and y["flux_d"] == y["flux_d_id"],
         f"{y['flux_d']:.4g} {m['flux_d']:.4g}",
     )
-    check(
+    checks.check(
         "PFV: the sources' fluxes leave through the walls",
         rel(m["flux_c"] + m["flux_d"], sum(m["q"])) < 1e-9,
         f"{m['flux_c'] + m['flux_d']:.6g} {sum(m['q']):.6g}",
     )
-    check(
+    checks.check(
         "setCellPImposed(False) frees the cell again",
         abs(y["freed"] - 0.3) > 1e-3 and abs(m["freed"] - 0.3) > 1e-3 and rel(y["freed"], m["freed"]) < 0.02,
     )
@@ -331,13 +331,13 @@ def scene_c(kind):
 
 
 def compare_c(y, m):
-    check(
+    checks.check(
         "blockHook + blockCell: the flux drop within 1 %",
         rel(y["ratio"], m["ratio"]) < 0.01 and m["ratio"] < 0.99,
         f"{y['ratio']:.5f} {m['ratio']:.5f}",
     )
-    check("a cell blocked with its pressure holds 0, imposed", y["p"] == 0 and m["p"] == 0 and m["imposed"])
-    check("PFV: mass conserved around blocked cells", abs(m["balance"]) < 1e-9 * abs(m["ratio"]))
+    checks.check("a cell blocked with its pressure holds 0, imposed", y["p"] == 0 and m["p"] == 0 and m["imposed"])
+    checks.check("PFV: mass conserved around blocked cells", abs(m["balance"]) < 1e-9 * abs(m["ratio"]))
 
 
 def scene_d(kind, threshold):
@@ -432,13 +432,13 @@ def main():
     O.run(1, True)
     threshold = float(np.quantile(flow.core.cell_volumes(), 0.05))
     dy, dm = scene_d("yade", threshold), scene_d("pfv", threshold)
-    check(
+    checks.check(
         "flatThreshold: the flux drop within 1 %",
         rel(dy["ratio"], dm["ratio"]) < 0.01 and dm["ratio"] < 0.999,
         f"{dy['ratio']:.5f} {dm['ratio']:.5f}",
     )
     ey, em = scene_e("yade"), scene_e("pfv")
-    check(
+    checks.check(
         "boundaryXPos/boundaryPressure on ymax: probe pressures within 0.02",
         np.abs(ey["p"] - em["p"]).max() < 0.02 and em["p"].max() > 0.05,
         f"{np.abs(ey['p'] - em['p']).max():.3g}",
@@ -450,13 +450,13 @@ def main():
             sphere_force(kind, pressureForce=False),
         )
         fluid = np.linalg.norm(free - decoupled)
-        check(
+        checks.check(
             f"decoupleForces / pressureForce=False apply no fluid force ({kind})",
             fluid > 0 and np.array_equal(decoupled, off),
             f"fluid force {fluid:.3g}",
         )
     gy, gm = scene_g("yade"), scene_g("pfv")
-    check(
+    checks.check(
         "mask: the same spheres left out",
         gy["n"] == gm["n"] and rel(gy["q"], gm["q"]) < 0.01,
         f"{gy['n']} {gm['n']} {gy['q']:.5g} {gm['q']:.5g}",
@@ -464,14 +464,14 @@ def main():
     # YADE's bounding spheres take the faces, but its boundary records keep the wall centres: its flux with
     # thick walls is far from its own thin-wall flux (printed, not checked; doc/yade.md).
     hy, hm, h0 = scene_h("yade"), scene_h("pfv"), scene_h("pfv", wall_thickness=0.0)
-    check(
+    checks.check(
         "wallThickness: the planes on the inner faces, the thin-wall flux (PFV)",
         rel(hm["q"], m["q"]) < 1e-9 and rel(h0["q"], m["q"]) < 1e-9,
         f"pfv {hm['q']:.5g} (wallThickness=0: {h0['q']:.5g}), thin walls {m['q']:.5g}; YADE {hy['q']:.5g}, thin "
         f"walls {y['q']:.5g}",
     )
     iy, im = scene_i("yade"), scene_i("pfv")
-    check(
+    checks.check(
         "idOffset < 0: wallIds after the bodies, the same flux",
         iy["walls"] == im["walls"] == list(range(1006, 1012))
         and iy["offset"] == im["offset"] == 1006
@@ -480,7 +480,7 @@ def main():
     )
     ky, km = scene_k("yade"), scene_k("pfv")
     expected = -0.1 * km["dt"] / 1.0
-    check(
+    checks.check(
         "epsVolMax: the box's volume strain of a step",
         rel(km["eps"], expected) < 1e-3 and rel(ky["eps"], expected) < 1e-2,
         f"{ky['eps']:.4g} {km['eps']:.4g} expected {expected:.4g}",
@@ -488,7 +488,7 @@ def main():
     # Inside fixed walls the squeeze expels nothing (the cells on the walls gain what the others lose) unless
     # the volume change of the cells off the walls is scaled.
     plain, half = [scene_l(kind) for kind in ENGINES], [scene_l(kind, volumeCorrection=0.5) for kind in ENGINES]
-    check(
+    checks.check(
         "volumeCorrection scales the volume change of the cells off the walls alike",
         rel(half[0]["out"], half[1]["out"]) < 0.02 and abs(plain[1]["out"]) < 1e-6 * abs(half[1]["out"]),
         f"expelled {half[0]['out']:.5g} {half[1]['out']:.5g}, without {plain[0]['out']:.3g} {plain[1]['out']:.3g}",
@@ -499,19 +499,14 @@ def main():
     )
     box = np.prod((spheres[:, :3] + spheres[:, 3:]).max(axis=0) - (spheres[:, :3] - spheres[:, 3:]).min(axis=0))
     # The last step's positions are those before NewtonIntegrator moved the spheres.
-    check(
+    checks.check(
         "desiredPorosity sets volumeCorrection from the porosity of the spheres' box, as YADE",
         rel(dy["correction"], dm["correction"]) < 1e-9
         and dm["correction"] != 1.0
         and rel(dm["correction"], 0.2 / ((box - 4 / 3 * np.pi * np.sum(spheres[:, 3] ** 3)) / box)) < 1e-5,
         f"{dy['correction']!r} {dm['correction']!r}",
     )
-    failed = 0
-    for name, ok, detail in results:
-        failed += not ok
-        print(f"{'ok  ' if ok else 'FAIL'} {name}" + (f"  [{detail}]" if detail else ""))
-    print(f"{len(results) - failed}/{len(results)} checks passed")
-    return 1 if failed else 0
 
 
-sys.exit(main())
+main()
+checks.report("cell interface vs YADE")

@@ -24,38 +24,17 @@ Checks
 import math
 import os
 import shutil
-import sys
 import tempfile
 import xml.etree.ElementTree as ElementTree
 
 import numpy as np  # noqa: E402
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from yade import O  # noqa: E402
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 from vtkmodules.vtkCommonDataModel import VTK_HEXAHEDRON, VTK_TETRA, VTK_VERTEX, VTK_WEDGE  # noqa: E402
 from vtkmodules.vtkFiltersVerdict import vtkCellSizeFilter  # noqa: E402
 from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader  # noqa: E402
 from pfv import FlowEngine  # noqa: E402
-
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
-
-
-def expect_error(what, kind, fragment, action):
-    try:
-        action()
-    except kind as error:
-        check(fragment in str(error), f"{what}: {type(error).__name__}: {error}")
-        return
-    except Exception as error:  # noqa: BLE001
-        check(False, f"{what}: expected {kind.__name__}, got {type(error).__name__}: {error}")
-        return
-    check(False, f"{what}: no error raised")
 
 
 def read(path):
@@ -138,10 +117,10 @@ def check_pores(path, state, with_boundaries, label):
     n = len(state["ids"])
     wall_count = (state["vertices"] >= n).sum(axis=1)
     kept = np.arange(state["n_cells"]) if with_boundaries else np.flatnonzero(wall_count == 0)
-    check(
-        grid.GetNumberOfCells() == len(kept),
+    checks.check(
         f"{label}: {grid.GetNumberOfCells()} cells = {len(kept)} "
         f"({'every cell' if with_boundaries else 'cells without a wall vertex'} of {state['n_cells']})",
+        grid.GetNumberOfCells() == len(kept),
     )
     expected = dict(
         Pressure=(state["pressure"][kept], "double"),
@@ -155,62 +134,66 @@ def check_pores(path, state, with_boundaries, label):
     )
     for name, (values, kind) in expected.items():
         got = data.get(name)
-        check(
-            got is not None and got[1] == kind and same(got[0], values), f"{label}: {name} ({kind}) equals the engine's"
+        checks.check(
+            f"{label}: {name} ({kind}) equals the engine's", got is not None and got[1] == kind and same(got[0], values)
         )
-    check(
+    checks.check(
+        f"{label}: Pressure agrees with getCellPressure",
         same(data["Pressure"][0][np.searchsorted(kept, np.arange(0, state["n_cells"], 97))], state["cell_pressure"])
         if with_boundaries
         else True,
-        f"{label}: Pressure agrees with getCellPressure",
     )
     points = vtk_to_numpy(grid.GetPoints().GetData())
-    check(
+    checks.check(
+        f"{label}: points 0..n-1 are the sphere centres (Float64)",
         grid.GetPoints().GetData().GetDataTypeAsString() == "double"
         and same(points[:n], state["positions"])
         and same(points[:n], state["bodies"]),
-        f"{label}: points 0..n-1 are the sphere centres (Float64)",
     )
     field = arrays(grid.GetFieldData())
-    check(same(field["TimeValue"][0], [state["time"]]), f"{label}: TimeValue = O.time of the call")
+    checks.check(f"{label}: TimeValue = O.time of the call", same(field["TimeValue"][0], [state["time"]]))
     types, members = cells(grid)
     type_of = np.array([VTK_TETRA, VTK_WEDGE, VTK_HEXAHEDRON, VTK_HEXAHEDRON])
-    check(same(types, type_of[wall_count[kept]]), f"{label}: tetrahedra, wedges (1 wall), hexahedra (2, 3 walls)")
+    checks.check(
+        f"{label}: tetrahedra, wedges (1 wall), hexahedra (2, 3 walls)", same(types, type_of[wall_count[kept]])
+    )
     bad = [
         c
         for c, m in zip(kept, members)
         if not same(np.unique(points[m], axis=0), expected_points(state, state["vertices"][c]))
     ]
-    check(not bad, f"{label}: each cell's points are its sphere centres and their wall projections ({len(bad)} not)")
+    checks.check(
+        f"{label}: each cell's points are its sphere centres and their wall projections ({len(bad)} not)", not bad
+    )
     sizes = vtkCellSizeFilter()
     sizes.SetInputData(grid)
     sizes.Update()
     vtk_volume = vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume"))
     volume = state["volume"][kept]
     error = np.max(np.abs(vtk_volume - volume) / volume)
-    check(
-        vtk_volume.min() > 0 and error < 1e-12,
+    checks.check(
         f"{label}: VTK's cell volumes are positive and equal Volume (largest relative difference {error:.1e})",
+        vtk_volume.min() > 0 and error < 1e-12,
     )
     if with_boundaries:
         walls = state["walls"]
         box = (walls[1] - walls[0]) * (walls[3] - walls[2]) * (walls[5] - walls[4])
-        check(
-            math.isclose(vtk_volume.sum(), box, rel_tol=1e-12),
+        checks.check(
             f"{label}: the cells tile the box (sum of VTK volumes {vtk_volume.sum():.15g}, box {box:.15g})",
+            math.isclose(vtk_volume.sum(), box, rel_tol=1e-12),
         )
-        check(
-            len(np.unique(points, axis=0)) == len(points),
+        checks.check(
             f"{label}: no point twice ({len(points)} points): neighbouring cells share their wall points",
+            len(np.unique(points, axis=0)) == len(points),
         )
         imposed = data["PressureSource"][0]
-        check(
+        checks.check(
+            f"{label}: imposed pressure in the cells of walls 2, 3 and of the imposed point "
+            f"({[(int(v), int((imposed == v).sum())) for v in np.unique(imposed)]})",
             (imposed == 2).sum() > 0
             and (imposed == 3).sum() > 0
             and (imposed == 6).sum() == 1
             and set(np.unique(imposed)) == {-1, 2, 3, 6},
-            f"{label}: imposed pressure in the cells of walls 2, 3 and of the imposed point "
-            f"({[(int(v), int((imposed == v).sum())) for v in np.unique(imposed)]})",
         )
     return grid
 
@@ -220,28 +203,30 @@ def check_spheres(path, state, label):
     n = len(state["ids"])
     data = arrays(grid.GetPointData())
     points = vtk_to_numpy(grid.GetPoints().GetData())
-    check(grid.GetNumberOfPoints() == n and same(points, state["bodies"]), f"{label}: points are the sphere centres")
-    types, members = cells(grid)
-    check(
-        same(types, np.full(n, VTK_VERTEX)) and same(np.concatenate(members), np.arange(n)),
-        f"{label}: one vertex cell per sphere",
+    checks.check(
+        f"{label}: points are the sphere centres", grid.GetNumberOfPoints() == n and same(points, state["bodies"])
     )
-    check(data["radii"][1] == "double" and same(data["radii"][0], state["body_radii"]), f"{label}: radii")
-    check(same(data["id"][0], state["ids"]), f"{label}: id = YADE ids")
-    check(
+    types, members = cells(grid)
+    checks.check(
+        f"{label}: one vertex cell per sphere",
+        same(types, np.full(n, VTK_VERTEX)) and same(np.concatenate(members), np.arange(n)),
+    )
+    checks.check(f"{label}: radii", data["radii"][1] == "double" and same(data["radii"][0], state["body_radii"]))
+    checks.check(f"{label}: id = YADE ids", same(data["id"][0], state["ids"]))
+    checks.check(
+        f"{label}: fluidForce = fluidForce(id)",
         data["fluidForce"][1] == "double"
         and same(data["fluidForce"][0], state["fluid_force"])
         and same(data["fluidForce"][0], state["forces"][:n]),
-        f"{label}: fluidForce = fluidForce(id)",
     )
     field = arrays(grid.GetFieldData())
-    check(
+    checks.check(
+        f"{label}: walls' ids, positions, fluid forces",
         same(field["wallIds"][0], np.arange(6))
         and same(field["wallPositions"][0], state["walls"])
         and same(field["wallFluidForce"][0], state["wall_force"]),
-        f"{label}: walls' ids, positions, fluid forces",
     )
-    check(same(field["TimeValue"][0], [state["time"]]), f"{label}: TimeValue = O.time of the call")
+    checks.check(f"{label}: TimeValue = O.time of the call", same(field["TimeValue"][0], [state["time"]]))
     return grid
 
 
@@ -270,12 +255,22 @@ try:
     plain, boundaries, compressed = (os.path.join(root, d) for d in ("plain", "boundaries", "compressed"))
 
     # 1. Before the first step, and bad arguments.
-    expect_error("saveVtk before the first step", RuntimeError, "not run yet", lambda: flow.saveVtk(plain))
-    check(not os.path.exists(plain), "nothing written before the first step")
+    checks.expect_error(
+        "saveVtk before the first step", RuntimeError, "not run yet", lambda: flow.saveVtk(plain), ignore_case=False
+    )
+    checks.check("nothing written before the first step", not os.path.exists(plain))
     O.run(2, True)
-    expect_error("saveVtk(folder=3)", TypeError, "folder", lambda: flow.saveVtk(3))
-    expect_error("saveVtk(withBoundaries='yes')", TypeError, "withBoundaries", lambda: flow.saveVtk(plain, "yes"))
-    expect_error("saveVtk(compress=None)", TypeError, "compress", lambda: flow.saveVtk(plain, compress=None))
+    checks.expect_error("saveVtk(folder=3)", TypeError, "folder", lambda: flow.saveVtk(3), ignore_case=False)
+    checks.expect_error(
+        "saveVtk(withBoundaries='yes')",
+        TypeError,
+        "withBoundaries",
+        lambda: flow.saveVtk(plain, "yes"),
+        ignore_case=False,
+    )
+    checks.expect_error(
+        "saveVtk(compress=None)", TypeError, "compress", lambda: flow.saveVtk(plain, compress=None), ignore_case=False
+    )
 
     # 2. Two snapshots at two iterations; the same states with boundaries, compressed and not.
     states = []
@@ -286,9 +281,11 @@ try:
         flow.saveVtk(plain)
         flow.saveVtk(boundaries, True)
         flow.saveVtk(compressed, withBoundaries=True, compress=True)
-    check(states[1]["time"] > states[0]["time"], f"two snapshots at O.time {states[0]['time']} and {states[1]['time']}")
+    checks.check(
+        f"two snapshots at O.time {states[0]['time']} and {states[1]['time']}", states[1]["time"] > states[0]["time"]
+    )
     names = sorted(os.listdir(plain))
-    check(names == ["out.pvd", "out_0.vtu", "out_1.vtu", "spheres_0.vtu", "spheres_1.vtu"], f"files: {names}")
+    checks.check(f"files: {names}", names == ["out.pvd", "out_0.vtu", "out_1.vtu", "spheres_0.vtu", "spheres_1.vtu"])
 
     tree = ElementTree.parse(os.path.join(plain, "out.pvd")).getroot()
     entries = [d.attrib for d in tree.iter("DataSet")]
@@ -298,14 +295,14 @@ try:
         for k, s in enumerate(states)
         for part, name, prefix in (("0", "pores", "out"), ("1", "spheres", "spheres"))
     ]
-    check(
-        tree.get("type") == "Collection" and listed == wanted, f"out.pvd lists both snapshots at their times: {listed}"
+    checks.check(
+        f"out.pvd lists both snapshots at their times: {listed}", tree.get("type") == "Collection" and listed == wanted
     )
     for e in entries:
         grid = read(os.path.join(plain, e["file"]))
-        check(
-            same(arrays(grid.GetFieldData())["TimeValue"][0], [float(e["timestep"])]),
+        checks.check(
             f"{e['file']} read through out.pvd: TimeValue = its timestep",
+            same(arrays(grid.GetFieldData())["TimeValue"][0], [float(e["timestep"])]),
         )
 
     # 3-5. Every file against the engine's values at its call.
@@ -319,12 +316,11 @@ try:
             with open(packed, "rb") as f:
                 header = f.read(400)
             smaller = os.path.getsize(packed) < os.path.getsize(os.path.join(boundaries, name))
-            check(
-                b'compressor="vtkZLibDataCompressor"' in header and smaller and same_grids(read(packed), grid),
+            checks.check(
                 f"compressed {name}: zlib, smaller, same data",
+                b'compressor="vtkZLibDataCompressor"' in header and smaller and same_grids(read(packed), grid),
             )
 finally:
     shutil.rmtree(root, ignore_errors=True)
 
-print(f"{len(failures)} failures")
-sys.exit(1 if failures else 0)
+checks.report("saveVtk")

@@ -6,10 +6,9 @@ the C++ API. The core decides; neither Python layer requests a rebuild of its ow
     yade-double -n -x tests/yade/engine/test_settings_invalidation.py      (exit 0 = pass)
 """
 import ast
-import sys
 
 import numpy as np  # noqa: E402
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from pfv_testing.settings_table import change, rows as read_table
 from yade import O  # noqa: E402
 import pfv  # noqa: E402
@@ -52,24 +51,16 @@ def through_flow_engine(row):
 def main():
     spheres = np.array(scenes.packing(1000))
     centres, radii = np.ascontiguousarray(spheres[:, :3]), np.ascontiguousarray(spheres[:, 3])
-    failures = []
     rows = read_table()
     for row in rows:
         seen = {"core": through_core(row, centres, radii)}
         if row["yade"] != "-":
             seen["FlowEngine"] = through_flow_engine(row)
         print(f"{row['core']:30s} expected {row['rebuild']:7s} seen {seen}")
-        failures += [
-            f"{row['core']} through {api}: {got}, expected {row['rebuild']}"
-            for api, got in seen.items()
-            if got != row["rebuild"]
-        ]
-    if len(rows) < 20:
-        failures.append(f"the table has only {len(rows)} rows")
-    for f in failures:
-        print("FAIL:", f)
-    print("settings invalidation:", "PASS" if not failures else "FAIL")
-    sys.exit(1 if failures else 0)
+        for api, got in seen.items():
+            checks.check(f"{row['core']} through {api}: {got}, expected {row['rebuild']}", got == row["rebuild"])
+    checks.check(f"the table has {len(rows)} rows (at least 20)", not len(rows) < 20)
+    checks.report("settings invalidation")
 
 
 main()

@@ -31,10 +31,9 @@ Checks
 """
 import math
 import random
-import sys
 import warnings
 
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from yade import O, utils  # noqa: E402
 from yade.wrapper import NewtonIntegrator, Sphere  # noqa: E402
 from yade.minieigenHP import Vector3  # noqa: E402
@@ -43,13 +42,6 @@ from pfv.flow_engine import TimeStepWarning  # noqa: E402
 
 MU = 1000.0
 V0 = 1e-4  # m/s, initial random velocity scale (spheres of radius ~0.05 m)
-failures = []
-
-
-def check(ok, text):
-    print(("ok   " if ok else "FAIL ") + text)
-    if not ok:
-        failures.append(text)
 
 
 _relaxed = []
@@ -148,13 +140,13 @@ rho_d2 = min(
 dt_mv_formula = math.pi * rho_d2 / (1200 * MU)
 dt_mv = flow.viscous_time_step
 dt_dem = utils.PWaveTimeStep()
-check(
-    abs(dt_mv / dt_mv_formula - 1) < 1e-9, "dt_MV = %.6g s = pi rho d^2 / (1200 mu) = %.6g s" % (dt_mv, dt_mv_formula)
+checks.check(
+    "dt_MV = %.6g s = pi rho d^2 / (1200 mu) = %.6g s" % (dt_mv, dt_mv_formula), abs(dt_mv / dt_mv_formula - 1) < 1e-9
 )
-check(
-    abs(flow.critical_time_step / min(dt_mv, dt_dem) - 1) < 1e-9,
+checks.check(
     "critical_time_step %.6g s = min(dt_MV, P-wave %.6g s); dt_DEM / dt_MV = %.1f"
     % (flow.critical_time_step, dt_dem, dt_dem / dt_mv),
+    abs(flow.critical_time_step / min(dt_mv, dt_dem) - 1) < 1e-9,
 )
 
 # 2. 1.5 dt_MV: warned first, then blows up -----------------------------------------------------------------------
@@ -168,19 +160,19 @@ print(
     "     1.5 dt_MV: KE/KE0 after steps 1..%d: %s%s"
     % (len(hist), " ".join("%.3g" % r for r in hist[:25]), (" ... run stopped: " + error) if error else "")
 )
-check(len(dt_warnings) == 1, "one TimeStepWarning at 1.5 dt_MV (got %d)" % len(dt_warnings))
+checks.check("one TimeStepWarning at 1.5 dt_MV (got %d)" % len(dt_warnings), len(dt_warnings) == 1)
 if dt_warnings:
     step_w, w = dt_warnings[0]
-    check(step_w == 1, "warned at coupled step %d (the first): %s" % (step_w, str(w.message)[:120]))
-    check(
-        not grown or step_w < grown[0],
+    checks.check("warned at coupled step %d (the first): %s" % (step_w, str(w.message)[:120]), step_w == 1)
+    checks.check(
         "warned (step %d) before the kinetic energy grew tenfold (step %s)" % (step_w, grown[0] if grown else "never"),
+        not grown or step_w < grown[0],
     )
 blew = max(hist, default=0) > 1e6 or (error is not None and max(hist, default=0) > 10)
-check(
-    blew,
+checks.check(
     "1.5 dt_MV blows up: max KE/KE0 = %.3g within %d steps%s"
     % (max(hist, default=0), len(hist), (" (then: %s)" % error) if error else ""),
+    blew,
 )
 
 # 3. strict_time_step raises ---------------------------------------------------------------------------------------
@@ -195,19 +187,21 @@ with warnings.catch_warnings(record=True) as caught:
         raised = None
     except RuntimeError as e:
         raised = str(e)
-check(
-    raised is not None and "exceeds the coupled stability limit" in raised,
+checks.check(
     "strict_time_step: the step raises naming the limit (%s)"
     % ((raised or "no error").strip().splitlines()[-1][:110] if raised else "no error"),
+    raised is not None and "exceeds the coupled stability limit" in raised,
 )
-check(O.iter == it0, "strict_time_step: O.iter did not advance (%d -> %d)" % (it0, O.iter))
-check(not [w for w in caught if issubclass(w.category, TimeStepWarning)], "strict_time_step: raises instead of warning")
+checks.check("strict_time_step: O.iter did not advance (%d -> %d)" % (it0, O.iter), O.iter == it0)
+checks.check(
+    "strict_time_step: raises instead of warning", not [w for w in caught if issubclass(w.category, TimeStepWarning)]
+)
 try:
     flow._time_step.check(O.dt)
     direct = None
 except ValueError as e:
     direct = str(e)
-check(direct is not None, "strict_time_step: the engine's check raises ValueError")
+checks.check("strict_time_step: the engine's check raises ValueError", direct is not None)
 flow.strict_time_step = False
 
 
@@ -229,10 +223,10 @@ def stable_run(factor, label, flow=None):
         )
     )
     ok = error is None and len(hist) == 300 and max(hist) < 2 and hist[-1] < 1
-    check(
-        ok,
+    checks.check(
         "%s: O.dt = %.3g dt_MV is stable (max KE/KE0 %.3g over %d steps, final %.3g)"
         % (label, factor, max(hist, default=float('nan')), len(hist), hist[-1] if hist else float('nan')),
+        ok,
     )
     return ok, seen
 
@@ -250,18 +244,18 @@ print(
     "linearised fluid operator; the thesis' single-particle dt_MV is not a safe bound for collective modes)"
     % (dt_collective, dt_collective / dt_mv)
 )
-check(dt_collective < dt_mv, "the collective limit is below dt_MV on this dense packing")
+checks.check("the collective limit is below dt_MV on this dense packing", dt_collective < dt_mv)
 bound = flow.collective_viscous_bound
-check(
-    0.1 * dt_collective < bound <= dt_collective,
+checks.check(
     "collective_viscous_bound %.3g dt_MV: certified below the limit, within an order of magnitude of it"
     % (bound / dt_mv),
+    0.1 * dt_collective < bound <= dt_collective,
 )
 factor = flow.time_step_safety * flow.critical_time_step / flow.viscous_time_step
 ok, seen = stable_run(factor, "engine limit")
-check(
-    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
+checks.check(
     "no TimeStepWarning at O.dt = time_step_safety * critical_time_step = %.3g dt_MV" % factor,
+    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
 )
 
 # 6. the limit follows the compaction: recomputed at the remesh, warned there ------------------------------------------
@@ -274,9 +268,9 @@ O.dt = flow.time_step_safety * flow.critical_time_step  # accepted silently on t
 factor = O.dt / dt_mv
 random_velocities()
 hist, seen, error = run_steps(5, kinetic())
-check(
-    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
+checks.check(
     "loose packing at %.3g dt_MV: no warning" % factor,
+    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
 )
 compact(flow)
 random_velocities()
@@ -300,15 +294,18 @@ print(
     % (1e3 * remesh, 1e3 * history[-1]["seconds"], 100 * history[-1]["seconds"] / remesh)
 )
 # history[0]: the first mesh; history[1]: the remesh onto the compacted packing (a blown-up run may remesh again later)
-check(
-    len(history) >= 2 and history[1]["warm"] and history[1]["iter"] == it0,
+checks.check(
     "the limit was recomputed (warm start) on the new mesh, at the remesh step",
+    len(history) >= 2 and history[1]["warm"] and history[1]["iter"] == it0,
 )
 compacted = history[1]["limit"] if len(history) >= 2 else loose
 # The guard asks the certified bound first: on the loose packing at 1e-4 dt_MV it sufficed (no limit computed by
 # the guard at that step, only by the query after it), on the compacted one at the step near the limit it did not.
 bounds = [h for h in records if h["method"] == "bound"]
-check(
+checks.check(
+    "the guard's order: bound on the first mesh (sufficed at 1e-4 dt_MV), the limit when queried; bound on the "
+    "compacted mesh (not enough at %.3g dt_MV), then the limit (got %s)"
+    % (factor, [(h["method"], h["iter"]) for h in records[:4]]),
     len(records) >= 4
     and records[0]["method"] == "bound"
     and records[1]["method"] == "arnoldi"
@@ -317,29 +314,26 @@ check(
     and records[2]["method"] == "bound"
     and records[3]["method"] == "power"
     and O.dt > 0.8 * records[2]["limit"],
-    "the guard's order: bound on the first mesh (sufficed at 1e-4 dt_MV), the limit when queried; bound on the "
-    "compacted mesh (not enough at %.3g dt_MV), then the limit (got %s)"
-    % (factor, [(h["method"], h["iter"]) for h in records[:4]]),
 )
-check(
-    all(0 < b["limit"] <= h["limit"] for b, h in zip(bounds[:2], history[:2])),
+checks.check(
     "each bound lies below the limit of its mesh (%s)"
     % "; ".join("%.3g <= %.3g dt_MV" % (b["limit"] / dt_mv, h["limit"] / dt_mv) for b, h in zip(bounds, history)),
+    all(0 < b["limit"] <= h["limit"] for b, h in zip(bounds[:2], history[:2])),
 )
-check(
-    compacted < 0.85 * loose,
+checks.check(
     "compaction by %g %% lowers the collective limit from %.3f to %.3f dt_MV"
     % (100 * (1 - COMPACTION), loose / dt_mv, compacted / dt_mv),
+    compacted < 0.85 * loose,
 )
-check(
-    len(dt_warnings) == 1 and dt_warnings[0][0] == 1,
+checks.check(
     "one TimeStepWarning, at the remesh step (got %s)" % [k for k, _ in dt_warnings],
+    len(dt_warnings) == 1 and dt_warnings[0][0] == 1,
 )
 grown = [k for k, r in enumerate(hist, 1) if r > 10]
-check(
-    max(hist, default=0) > 1e6 and (not dt_warnings or not grown or dt_warnings[0][0] < grown[0]),
+checks.check(
     "the compacted packing at %.3g dt_MV (%.2f x its limit) blows up: max KE/KE0 %.3g, after the warning"
     % (factor, O.dt / compacted, max(hist, default=0)),
+    max(hist, default=0) > 1e6 and (not dt_warnings or not grown or dt_warnings[0][0] < grown[0]),
 )
 
 flow = build()
@@ -355,9 +349,9 @@ try:
     raised = None
 except RuntimeError as e:
     raised = str(e)
-check(
-    raised is not None and "collective viscous limit" in raised and O.iter == it0,
+checks.check(
     "strict_time_step: the remesh step on the compacted packing raises, O.iter unchanged",
+    raised is not None and "collective viscous limit" in raised and O.iter == it0,
 )
 
 flow = build()
@@ -366,10 +360,9 @@ O.step()
 compact(flow)
 O.step()
 ok, seen = stable_run(flow.time_step_safety * flow.critical_time_step / dt_mv, "compacted, its engine limit", flow)
-check(
-    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
+checks.check(
     "no TimeStepWarning at time_step_safety * critical_time_step of the compacted packing",
+    not [w for w in seen if issubclass(w[1].category, TimeStepWarning)],
 )
 
-print("%d failed" % len(failures))
-sys.exit(1 if failures else 0)
+checks.report("time step stability")

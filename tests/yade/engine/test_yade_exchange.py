@@ -12,24 +12,15 @@ readers must give identical pressures and forces at every step, also across the 
 sphere (which leaves len(O.bodies) unchanged: the engine must notice it by the count of what it
 reads, rescan and remesh). The low-level functions must reject what they cannot read.
 """
-import sys
 
 import numpy as np
 
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from yade import O  # noqa: E402
 from yade.minieigenHP import Vector3  # noqa: E402
 from yade.wrapper import Sphere  # noqa: E402
 from yade._packSpheres import SpherePack  # noqa: E402
 from pfv import FlowEngine, _core  # noqa: E402
-
-failures = []
-
-
-def check(ok, text):
-    print(("ok   " if ok else "FAIL ") + text)
-    if not ok:
-        failures.append(text)
 
 
 STEPS, ERASE_AT = 12, 6
@@ -72,34 +63,34 @@ def run(use_pack):
     )
 
 
-check(
-    _core.sphere_pack_size(SpherePack()) == 0,
+checks.check(
     "this build reads YADE's SpherePack (Boost.Python found and the layout recognised)",
+    _core.sphere_pack_size(SpherePack()) == 0,
 )
 fast, lists = run(True), run(False)
-check(fast["source"] == "SpherePack", f"default reader: {fast['source']}")
-check(lists["source"] == "coordinate lists", f"reader with the pack switched off: {lists['source']}")
-check(fast["moved"] > 1e-9, f"the spheres move under the drag (largest displacement {fast['moved']:.3g})")
+checks.check(f"default reader: {fast['source']}", fast["source"] == "SpherePack")
+checks.check(f"reader with the pack switched off: {lists['source']}", lists["source"] == "coordinate lists")
+checks.check(f"the spheres move under the drag (largest displacement {fast['moved']:.3g})", fast["moved"] > 1e-9)
 for name, run_ in (("SpherePack", fast), ("coordinate lists", lists)):
-    check(
-        np.array_equal(run_["centres"], run_["python"]), f"{name}: every centre read equals b.state.pos after the run"
+    checks.check(
+        f"{name}: every centre read equals b.state.pos after the run", np.array_equal(run_["centres"], run_["python"])
     )
     before, after = run_["steps"][ERASE_AT - 1], run_["steps"][ERASE_AT]
-    check(
-        after["remeshes"] == before["remeshes"] + 1 and after["spheres"] == before["spheres"] - 1,
+    checks.check(
         f"{name}: erasing sphere #{victim} (len(O.bodies) unchanged) -> rescan and remesh "
         f"({before['spheres']} -> {after['spheres']} spheres, remesh {before['remeshes']} -> {after['remeshes']})",
+        after["remeshes"] == before["remeshes"] + 1 and after["spheres"] == before["spheres"] - 1,
     )
-    check(victim not in run_["ids"], f"{name}: the erased sphere is out of the flow")
+    checks.check(f"{name}: the erased sphere is out of the flow", victim not in run_["ids"])
 same = all(
     np.array_equal(a["p"], b["p"]) and np.array_equal(a["f"], b["f"]) for a, b in zip(fast["steps"], lists["steps"])
 )
-check(same, f"pressures and forces identical to the bit at all {STEPS} steps of both readers")
+checks.check(f"pressures and forces identical to the bit at all {STEPS} steps of both readers", same)
 
 # The low-level functions refuse what they cannot read.
-check(
-    _core.sphere_pack_size(O.forces) == -1 and _core.sphere_pack_size(3.0) == -1,
+checks.check(
     "sphere_pack_size is -1 for objects that are no SpherePack",
+    _core.sphere_pack_size(O.forces) == -1 and _core.sphere_pack_size(3.0) == -1,
 )
 pack = SpherePack()
 pack.fromSimulation()
@@ -116,23 +107,23 @@ def raises(kind, action):
 
 
 message = raises(ValueError, lambda: _core.gather_sphere_pack(O.forces, np.arange(2), np.empty((2, 3))))
-check(message is not None and "SpherePack" in message, f"gather from a non-pack: ValueError ({message})")
+checks.check(f"gather from a non-pack: ValueError ({message})", message is not None and "SpherePack" in message)
 out = np.full((2, 3), 7.0)
-check(
+checks.check(
+    "gather with the wrong expected size returns False and writes nothing; with the right one True",
     not _core.gather_sphere_pack(pack, np.arange(2), out, None, n + 1)
     and (out == 7.0).all()
     and _core.gather_sphere_pack(pack, np.arange(2), out, None, n)
     and (out != 7.0).any(),
-    "gather with the wrong expected size returns False and writes nothing; with the right one True",
 )
 message = raises(IndexError, lambda: _core.gather_sphere_pack(pack, np.array([n]), np.empty((1, 3))))
-check(message is not None and "outside the pack" in message, f"index beyond the pack: IndexError ({message})")
+checks.check(f"index beyond the pack: IndexError ({message})", message is not None and "outside the pack" in message)
 message = raises(ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(3), np.empty((2, 3))))
-check(message is not None and "shape" in message, f"centres of the wrong shape: ValueError ({message})")
+checks.check(f"centres of the wrong shape: ValueError ({message})", message is not None and "shape" in message)
 message = raises(
     ValueError, lambda: _core.gather_sphere_pack(pack, np.arange(2), np.empty((2, 3)), np.empty(2, dtype=np.float32))
 )
-check(message is not None and "radii" in message, f"radii not float64: ValueError ({message})")
+checks.check(f"radii not float64: ValueError ({message})", message is not None and "radii" in message)
 
 # Forces: the bridge calls YADE's force_add (the function O.forces.addF is bound to) directly;
 # O.forces must end up exactly as with one addF call per body, and as with the bridge's own
@@ -148,7 +139,7 @@ F = (
     * 10.0 ** np.random.default_rng(8).integers(-6, 6, len(ids))[:, None]
 )
 bridge = _core.YadeForceBridge(Vector3, ids, rows)
-check(bridge.calls_yade_directly, "the bridge found YADE's force_add")
+checks.check("the bridge found YADE's force_add", bridge.calls_yade_directly)
 
 
 def forces_after(write):
@@ -162,12 +153,14 @@ def forces_after(write):
 direct = forces_after(lambda add: bridge.apply(add, F))
 python = forces_after(lambda add: [add(int(i), tuple(F[r])) for i, r in zip(ids, rows)])
 fallback = forces_after(lambda add: bridge.apply(lambda i, f: add(i, f), F))
-check(np.array_equal(direct, python), "direct force_add: O.forces identical to addF from Python")
-check(np.array_equal(fallback, python), "fallback (addF with the bridge's Vector3s): identical too")
-check(np.array_equal(direct, 2 * F[rows]), "and equal to the forces given, added twice")
+checks.check("direct force_add: O.forces identical to addF from Python", np.array_equal(direct, python))
+checks.check("fallback (addF with the bridge's Vector3s): identical too", np.array_equal(fallback, python))
+checks.check("and equal to the forces given, added twice", np.array_equal(direct, 2 * F[rows]))
 bad = _core.YadeForceBridge(Vector3, np.array([n_bodies + 5], dtype=np.int64), np.array([0], dtype=np.int64))
 message = raises(IndexError, lambda: bad.apply(O.forces.addF, np.zeros((1, 3))))
-check(message is not None and "out of range" in message, f"a body id beyond the scene: YADE's IndexError ({message})")
+checks.check(
+    f"a body id beyond the scene: YADE's IndexError ({message})", message is not None and "out of range" in message
+)
 
 # The engine's overload reads the C++ force array itself (no numpy copy): the same sums.
 scenes.build_permeameter(num=1000, frozen=False)
@@ -184,14 +177,13 @@ sphere_bridge = _core.YadeForceBridge(
 )
 from_engine = forces_after(lambda add: sphere_bridge.apply(add, engine))
 from_array = forces_after(lambda add: sphere_bridge.apply(add, engine.forces()))
-check(
-    np.array_equal(from_engine, from_array) and np.abs(from_engine).max() > 0,
+checks.check(
     "apply(addF, engine) writes what apply(addF, engine.forces()) writes",
+    np.array_equal(from_engine, from_array) and np.abs(from_engine).max() > 0,
 )
 message = raises(ValueError, lambda: bridge.apply(O.forces.addF, engine))  # one force row per body of the scene
-check(message is None, "an engine with enough force rows is accepted")
+checks.check("an engine with enough force rows is accepted", message is None)
 message = raises(ValueError, lambda: bad.apply(O.forces.addF, _core.Engine()))
-check(message is not None and "does not match" in message, f"an engine without forces: ValueError ({message})")
+checks.check(f"an engine without forces: ValueError ({message})", message is not None and "does not match" in message)
 
-print(f"{len(failures)} failed")
-sys.exit(1 if failures else 0)
+checks.report("YADE exchange")

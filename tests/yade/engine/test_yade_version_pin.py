@@ -7,39 +7,31 @@ YADE whose yade.config.version reads otherwise raises that error (in a fresh yad
 """
 import os
 import subprocess
-import sys
 import tempfile
 
 import yade.config
 
 from pfv import _core
 from pfv._yade_version import YadeVersionError, check
-
-failures = []
-
-
-def expect(what, ok):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
+from pfv_testing import checks
 
 
 pinned = _core.PINNED_YADE_VERSION
-expect(f"the running YADE {yade.config.version} is the pinned {pinned}", yade.config.version == pinned)
+checks.check(f"the running YADE {yade.config.version} is the pinned {pinned}", yade.config.version == pinned)
 
 try:
     check(pinned, pinned)
-    expect("the pinned version passes", True)
+    checks.check("the pinned version passes", True)
 except ImportError as error:
-    expect(f"the pinned version passes ({error})", False)
+    checks.check(f"the pinned version passes ({error})", False)
 
 for other in ("2024.06a", "2023.02", "3.14"):
     try:
         check(other, pinned)
-        expect(f"{other} is refused", False)
+        checks.check(f"{other} is refused", False)
     except YadeVersionError as error:
         message = str(error)
-        expect(
+        checks.check(
             f"{other} is refused with an ImportError naming both versions",
             isinstance(error, ImportError) and other in message and pinned in message,
         )
@@ -57,10 +49,9 @@ with tempfile.TemporaryDirectory() as folder:
     out = subprocess.run(["yade-double", "-n", "-x", path], cwd=folder, capture_output=True, text=True)
 refused = [line for line in out.stdout.splitlines() if line.startswith("REFUSED")]
 print(out.stdout[-600:], out.stderr[-600:])
-expect(
+checks.check(
     "import pfv under YADE 2099.01z raises ImportError naming both versions",
     out.returncode == 0 and bool(refused) and "2099.01z" in refused[0] and pinned in refused[0],
 )
 
-print("FAILED:", failures if failures else "none")
-sys.exit(1 if failures else 0)
+checks.report("YADE version pin")

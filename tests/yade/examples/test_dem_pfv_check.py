@@ -13,11 +13,8 @@ ordering in both PFV runs.
 """
 import re
 import subprocess
-import sys
 
-from pfv_testing import paths
-
-failures = []
+from pfv_testing import checks, paths
 
 
 def run(*flags):
@@ -31,26 +28,20 @@ def permeability(text):
     return float(m.group(1)) if m else None
 
 
-def check(what, ok, detail=""):
-    print(("ok   " if ok else "FAIL ") + what + " " + detail)
-    if not ok:
-        failures.append(what)
-
-
 code, yade_engine = run()
-check(
+checks.check(
     "YADE's own engine passes its own check",
     code == 0 and "OK: DEM-PFV-check.py finished" in yade_engine,
     f"(exit {code})",
 )
 code, plain = run("--pfv")
-check(
+checks.check(
     "engine swapped: passes YADE's own tolerances",
     code == 0 and "OK: DEM-PFV-check.py finished" in plain,
     f"(exit {code})",
 )
 code, thesis = run("--pfv", "--thesis-wall-throats")
-check(
+checks.check(
     "thesis' wall formula: the script runs to its checks and stops there",
     "YadeCheckError" in thesis and "Traceback" in thesis and "DEM-PFV: unbalanced" not in thesis,
     f"(exit {code})",
@@ -61,21 +52,17 @@ k_plain = permeability(plain) or target  # printed only when more than 1 % off
 k_yade = permeability(yade_engine) or target
 # The script's packing comes from its own DEM compaction, which this build of YADE does not reproduce
 # bit for bit: its target is 9 % below YADE's engine here, so PFV is compared with the engine itself.
-check(
+checks.check(
     "by default PFV's permeability is YADE's engine's on the same packing (1 %)",
     abs(k_plain / k_yade - 1) < 0.01,
     f"(k = {k_plain} vs {k_yade})",
 )
-check(
+checks.check(
     "the thesis' wall formula raises the permeability by the size of the wall term",
     k_thesis is not None and 1.15 < k_thesis / k_plain < 1.45,
     f"(k = {k_thesis} vs {k_plain} by default, target {target})",
 )
 for name, text in (("default", plain), ("thesis formula", thesis)):
-    check(f"forceMetis gives a METIS ordering ({name})", "Metis is not used" not in text)
+    checks.check(f"forceMetis gives a METIS ordering ({name})", "Metis is not used" not in text)
 
-if failures:
-    print(f"{len(failures)} DEM-PFV-check checks failed")
-    sys.exit(1)
-print("all DEM-PFV-check checks passed")
-sys.exit(0)
+checks.report("DEM-PFV-check")

@@ -22,11 +22,9 @@ Checks
 3. With PFV's R_h instead, the difference is a factor, not round-off (norm ratio printed, > 1.5): the check above
    explains the whole gap, not part of it.
 """
-import sys
-
 import numpy as np
 
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from yade import O  # noqa: E402
 from yade.wrapper import FlowEngine as YadeFlowEngine  # noqa: E402
 import pfv  # noqa: E402
@@ -96,15 +94,13 @@ def compare(reference, other):
 def main():
     yade_run = run(YadeFlowEngine)
     pfv_run = run(pfv.FlowEngine)
-    failures = []
     ratio, cosine, _ = compare(yade_run['force'], pfv_run['force'])
     print('as computed: |F_pfv| / |F_yade| = %.4f, cosine %.5f' % (ratio, cosine))
 
     own = recompute(pfv_run['pairs'], pfv_run, yade_definition=False)
     _, _, residual = compare(pfv_run['force'], own)
     print('1. PFV recomputed from its pairs: relative difference %.2e' % residual)
-    if not residual < 1e-6:
-        failures.append('PFV forces are not mu S/R_h dV_t of its own pairs (%.2e)' % residual)
+    checks.check('PFV forces are mu S/R_h dV_t of its own pairs', residual < 1e-6, '(%.2e)' % residual)
 
     # YADE's run started from the same state; its pairs are PFV's (same regular triangulation of the same packing).
     as_yade = recompute(pfv_run['pairs'], yade_run, yade_definition=True)
@@ -113,20 +109,17 @@ def main():
         '2. YADE definition on PFV pairs vs YADE: ratio %.5f, cosine %.7f, relative difference %.2e'
         % (ratio_y, cosine_y, residual_y)
     )
-    if not (residual_y < 1e-3 and cosine_y > 0.99999):
-        failures.append(
-            'YADE forces not reproduced by R_h = gap + 0.45 r_min (residual %.2e, cosine %.7f)' % (residual_y, cosine_y)
-        )
+    checks.check(
+        'YADE forces reproduced by R_h = gap + 0.45 r_min',
+        residual_y < 1e-3 and cosine_y > 0.99999,
+        '(residual %.2e, cosine %.7f)' % (residual_y, cosine_y),
+    )
 
     pfv_rh = recompute(pfv_run['pairs'], yade_run, yade_definition=False)
     ratio_p, _, _ = compare(yade_run['force'], pfv_rh)
     print('3. PFV definition on the YADE run vs YADE: ratio %.3f' % ratio_p)
-    if not ratio_p > 1.5:
-        failures.append('the R_h difference no longer accounts for a factor (ratio %.3f)' % ratio_p)
-
-    for f in failures:
-        print('FAIL:', f)
-    return 1 if failures else 0
+    checks.check('the R_h difference accounts for a factor', ratio_p > 1.5, '(ratio %.3f)' % ratio_p)
 
 
-sys.exit(main())
+main()
+checks.report('viscous shear vs YADE')

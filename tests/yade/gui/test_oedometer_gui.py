@@ -16,29 +16,20 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 
-from pfv_testing import paths
+from pfv_testing import checks, paths
 
 DRIVER = paths.tool('gui_oedometer_driver.py')
 EXAMPLE = paths.example('oedometer.py')
 ARGS = ['--quick', '--set=Tv_end=0.2']
 KEYS = ('K', 'Cv', 'steps', 'final_U', 'U_max_abs_error', 'isochrone_rms_error', 'mid_pressure_rms_error')
-failures = []
-
-
-def check(ok, text):
-    print(('ok   ' if ok else 'FAIL ') + text, flush=True)
-    if not ok:
-        failures.append(text)
 
 
 def main():
     xvfb = shutil.which('xvfb-run')
     if not xvfb:
-        print('SKIP: xvfb-run not found (apt-get install xvfb xauth)')
-        return 77
+        checks.skip('xvfb-run not found (apt-get install xvfb xauth)')
     yade = shutil.which('yade-double') or '/usr/bin/yade-double'
     out = tempfile.mkdtemp(prefix='pfv-oedometer-gui-')
     env = dict(os.environ)
@@ -61,30 +52,29 @@ def main():
             (e.stdout or b'').decode(errors='replace') if isinstance(e.stdout, bytes) else (e.stdout or '')
         )
     print('\n'.join(line for line in text.splitlines() if line.startswith(('oedometer:', 'gui driver:'))))
-    check(code == 0, 'GUI run completed (exit %s)' % code)
+    checks.check('GUI run completed (exit %s)' % code, code == 0)
     gui_json = os.path.join(out, 'gui', 'gui.json')
     summary_path = os.path.join(out, 'gui', 'run', 'summary.json')
     if code != 0 or not os.path.exists(gui_json) or not os.path.exists(summary_path):
         print(text[-3000:])
-        print('%d failed; outputs in %s' % (len(failures) + 1, out))
-        return 1
+        checks.fail('the GUI run wrote gui.json and summary.json; outputs in %s' % out)
+        return
     with open(gui_json) as f:
         g = json.load(f)
-    check(
-        g['status'] == 'ok' and g['hasDisplay'],
+    checks.check(
         'the example ran in GUI mode (status %s, display %s)' % (g['status'], g['hasDisplay']),
+        g['status'] == 'ok' and g['hasDisplay'],
     )
     running = [t for t in g['ticks'] if t['running']]
     seen = set(w.split(':')[0] for t in running for w in t['windows'])
-    check(
+    checks.check(
+        "controller, 3D view and live figure on screen during the run (%s)" % sorted(seen),
         {'ControllerClass', 'QOpenGLWidget', 'MainWindow'} <= seen
         and max((t['views'] for t in running), default=0) >= 1,
-        "controller, 3D view and live figure on screen during the run (%s)" % sorted(seen),
     )
     iters = [t['iter'] for t in running]
     points = [t['points'] for t in running]
-    check(
-        len(running) >= 3 and iters[-1] > iters[0] and points[-1] > points[0],
+    checks.check(
         'GUI live during the run: %d half-second ticks while running, iterations %s .. %s, plot points %s .. %s'
         % (
             len(running),
@@ -93,8 +83,9 @@ def main():
             points[0] if points else '-',
             points[-1] if points else '-',
         ),
+        len(running) >= 3 and iters[-1] > iters[0] and points[-1] > points[0],
     )
-    check(os.path.exists(os.path.join(out, 'gui', 'screen.png')), 'screenshot taken')
+    checks.check('screenshot taken', os.path.exists(os.path.join(out, 'gui', 'screen.png')))
 
     head = os.path.join(out, 'headless')
     proc = subprocess.run(
@@ -105,22 +96,22 @@ def main():
         text=True,
         timeout=600,
     )
-    check(proc.returncode == 0, 'headless run completed (exit %d)' % proc.returncode)
+    checks.check('headless run completed (exit %d)' % proc.returncode, proc.returncode == 0)
     if proc.returncode == 0:
         with open(summary_path) as f:
             a = json.load(f)
         with open(os.path.join(head, 'summary.json')) as f:
             b = json.load(f)
         diff = [k for k in KEYS if a[k] != b[k]]
-        check(
-            not diff,
+        checks.check(
             'GUI and headless runs give the same results (%s; differ: %s)'
             % (', '.join('%s %.6g' % (k, a[k]) for k in KEYS), diff or 'none'),
+            not diff,
         )
-    print('%d failed; outputs in %s' % (len(failures), out))
-    if not failures:
+    print('outputs in %s' % out)
+    if not checks.failures:
         shutil.rmtree(out, ignore_errors=True)
-    return 1 if failures else 0
 
 
-sys.exit(main())
+main()
+checks.report('GUI oedometer')

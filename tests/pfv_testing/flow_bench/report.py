@@ -49,7 +49,7 @@ def slope(ns, ts):
 
 
 def thesis_fits():
-    """Table 5.6 fits (seconds for N spheres), model-spec section 9 / claim 21."""
+    """The thesis' Table 5.6 fits (seconds for N spheres)."""
     return {
         'triangulation': ('T_TRG = 5.8e-6 N log2 N', lambda n: 5.8e-6 * n * math.log2(n)),
         'geometry+conductance': ('T_G = 5.4e-5 N', lambda n: 5.4e-5 * n),
@@ -457,10 +457,7 @@ def _scaling_section(w, summ):
     sizes = summ[t1]['sizes']
     ns_list = sorted(sizes, key=int)
     nvals = [int(ns) for ns in ns_list]
-    w(
-        '### Scaling with N (%s thread%s) against the thesis fits (Table 5.6, model-spec section 9 / claim 21)'
-        % (t1, '' if t1 == '1' else 's')
-    )
+    w('### Scaling with N (%s thread%s) against the thesis fits (Table 5.6)' % (t1, '' if t1 == '1' else 's'))
     w('')
     w(
         'PFV stage time per sphere (us/sphere), fitted exponent b of t ~ N^b, and the thesis fit evaluated at '

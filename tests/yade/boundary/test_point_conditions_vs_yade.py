@@ -5,10 +5,8 @@ pressures at probe points (within 5 % of the pressure scale) and the drained flu
 
     yade-double -n -x tests/yade/boundary/test_point_conditions_vs_yade.py      (exit 0 = pass)
 """
-import sys
-
 import numpy as np  # noqa: E402
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from yade import O  # noqa: E402
 from yade.wrapper import FlowEngine as YadeFlowEngine  # noqa: E402
 import pfv  # noqa: E402
@@ -58,9 +56,7 @@ print(
     f"YADE: p_inj {yade['p_injection']:.6g}  q_top {yade['q_top']:.6g}   "
     f"pfv: p_inj {mine['p_injection']:.6g}  q_top {mine['q_top']:.6g}"
 )
-failed = 0
 for name, value, limit in rows:
     ok = value if isinstance(limit, bool) else value <= limit
-    failed += not ok
-    print(f"{name:48s} {value!s:>24}  limit {limit!s:>8}  {'ok' if ok else 'FAIL'}")
-sys.exit(1 if failed else 0)
+    checks.check(f"{name:48s}", bool(ok), f"{value!s:>24}  limit {limit!s:>8}")
+checks.report("point-condition")

@@ -177,6 +177,7 @@ def dump_json(path, halves):
 
 def main(argv):
     import traceback
+    from pfv_testing import checks
     from yade import O
     from yade.wrapper import FlowEngine as YadeFlow
 
@@ -193,7 +194,7 @@ def main(argv):
     if '--yade-only' in argv:
         if jsonPath:
             dump_json(jsonPath, [y])
-        return 0
+        return
 
     O.reset()
     try:
@@ -202,42 +203,34 @@ def main(argv):
         else:
             from pfv import FlowEngine as PfvFlow
     except Exception as e:
-        print(
+        checks.fail(
             'PFV_IMPORT_FAILED: cannot import pfv.FlowEngine (%s: %s). Build and install the pfv package '
             '(its directory must be on PYTHONPATH or in /usr/local/lib/python3.11/dist-packages).'
             % (type(e).__name__, e)
         )
-        return 1
+        return
     try:
         p = run_engine(
             PfvFlow, axis, steps, 'YADE FlowEngine (self-check)' if PfvFlow is YadeFlow else 'pfv FlowEngine'
         )
     except Exception:
         traceback.print_exc()
-        print('FAIL: the pfv half raised an exception')
-        return 1
+        checks.fail('the pfv half raised an exception')
+        return
     print_half(p)
     if jsonPath:
         dump_json(jsonPath, [y, p])
 
     rows = compare(y, p)
-    print('\n%-42s %12s %12s  %s' % ('check', 'value', 'limit', 'result'))
+    print()
     for name, value, limit, ok in rows:
-        print(
-            '%-42s %12.4e %12s  %s'
-            % (
-                name,
-                value,
-                '' if limit != limit else '%.1e' % limit,
-                '' if limit != limit else ('ok' if ok else 'FAIL'),
-            )
-        )
+        if limit != limit:  # an (info) row: printed, not checked
+            print('     %-42s %12.4e' % (name, value))
+        else:
+            checks.check('%-42s' % name, ok, '%12.4e  limit %.1e' % (value, limit))
     print('\n%-8s %14s %14s' % ('probe', 'p YADE', 'p pfv'))
     for k in (0, 4, 13, 22, 26):
         print('%-8d %14.6f %14.6f' % (k, y['p'][k], p['p'][k]))
-    failed = [r for r in rows if not r[3]]
-    print('\n%d passed, %d failed' % (len(rows) - len(failed), len(failed)))
-    return 1 if failed else 0
 
 
 def test_permeameter_vs_yade():
@@ -260,7 +253,10 @@ def test_permeameter_vs_yade():
 
 
 if __name__ == '__main__' and 'yade' in sys.modules:
-    sys.exit(main(sys.argv[1:]))
+    from pfv_testing import checks
+
+    main(sys.argv[1:])
+    checks.report('permeameter')
 elif __name__ == '__main__':
     print('run me with: yade-double -n -x %s' % sys.argv[0])
     sys.exit(2)

@@ -12,10 +12,7 @@ yade_wall_throat_factor=True, its default. Checks:
     YADE's: the factor is what separates the formulas on slip walls;
   * the factor leaves no-slip walls alone: identical fluxes with and without it.
 """
-import sys
-
-
-from pfv_testing import scenes
+from pfv_testing import checks, scenes
 from yade import O  # noqa: E402
 from yade.wrapper import FlowEngine as YadeFlow  # noqa: E402
 
@@ -34,11 +31,8 @@ def outflux(make_flow, slip=True, **extra):
 def main():
     from pfv import FlowEngine as PfvFlow
 
-    rows = []
-
     def check(name, value, ok):
-        rows.append((name, value, ok))
-        print('%-60s %10.5f  %s' % (name, value, 'ok' if ok else 'FAIL'))
+        checks.check('%-60s' % name, ok, '%10.5f' % value)
 
     q_yade = outflux(YadeFlow)
     q_pfv = outflux(PfvFlow)
@@ -50,9 +44,7 @@ def main():
     q_ns = outflux(PfvFlow, slip=False, yade_wall_throat_factor=False)
     q_ns_factor = outflux(PfvFlow, slip=False)
     check('no-slip walls: |Q(factor) / Q(no factor) - 1|', abs(q_ns_factor / q_ns - 1), q_ns_factor == q_ns)
-    failed = sum(1 for r in rows if not r[2])
-    print('%d passed, %d failed' % (len(rows) - failed, failed))
-    return 1 if failed else 0
 
 
-sys.exit(main())
+main()
+checks.report('wall throat factor')

@@ -5,8 +5,9 @@ re-runs a tiny script from a temporary directory with a clean environment instea
 """
 import os
 import subprocess
-import sys
 import tempfile
+
+from pfv_testing import checks
 
 script = "import pfv, sys\nfrom pfv import FlowEngine\nprint('PFV_AT', pfv.__file__)\nsys.exit(0)\n"
 with tempfile.TemporaryDirectory() as d:
@@ -18,5 +19,5 @@ with tempfile.TemporaryDirectory() as d:
     print(out.stdout[-500:], out.stderr[-500:])
     location = [line for line in out.stdout.splitlines() if line.startswith("PFV_AT")]
     ok = out.returncode == 0 and location and "dist-packages/pfv" in location[0]
-    print("installed pfv importable:", bool(ok))
-    sys.exit(0 if ok else 1)
+    checks.check("installed pfv importable", bool(ok))
+checks.report("installed import")

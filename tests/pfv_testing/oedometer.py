@@ -6,14 +6,14 @@ import shutil
 import subprocess
 import tempfile
 
-from pfv_testing import paths
+from pfv_testing import checks, paths
 
 EXAMPLE = paths.example('oedometer.py')
 
 
 def run_and_check(args, thresholds, extra_check=None):
     """thresholds: (name, summary key, lower, upper); extra_check(summary) -> list of (ok, message).
-    Returns the process exit code (0 = pass)."""
+    Each bound is a check of pfv_testing.checks; returns the exit code of the checks so far (0 = all passed)."""
     out = tempfile.mkdtemp(prefix='pfv-oedometer-test-')
     yade = shutil.which('yade-double') or '/usr/bin/yade-double'
     cmd = [yade, '-n', '-x', EXAMPLE] + list(args) + ['--out=' + out]
@@ -24,20 +24,16 @@ def run_and_check(args, thresholds, extra_check=None):
     path = os.path.join(out, 'summary.json')
     if proc.returncode != 0 or not os.path.exists(path):
         print(proc.stdout[-3000:])
-        print('FAIL the example did not complete (exit code %d)' % proc.returncode)
+        checks.fail('the example did not complete (exit code %d)' % proc.returncode)
         return 1
     with open(path) as f:
         s = json.load(f)
-    failures = 0
     for name, key, lo, hi in thresholds:
         v = s[key]
-        ok = math.isfinite(v) and lo <= v <= hi
-        failures += not ok
-        print('%s %s = %.4f (allowed %g .. %g)' % ('ok  ' if ok else 'FAIL', name, v, lo, hi))
+        checks.check(name, math.isfinite(v) and lo <= v <= hi, '= %.4f (allowed %g .. %g)' % (v, lo, hi))
     for ok, message in extra_check(s) if extra_check else []:
-        failures += not ok
-        print('%s %s' % ('ok  ' if ok else 'FAIL', message))
-    print('%d failed; outputs in %s' % (failures, out))
-    if not failures:
+        checks.check(message, ok)
+    print('%d failed; outputs in %s' % (len(checks.failures), out))
+    if not checks.failures:
         shutil.rmtree(out, ignore_errors=True)
-    return 1 if failures else 0
+    return 1 if checks.failures else 0

@@ -27,6 +27,7 @@ import yade
 from yade import O
 
 import pfv
+from pfv_testing import checks
 
 SCRIPT = os.path.join(yade.config.libDir, "py/yade/tests/checks/checkDEM-PFVPressureInjection.py")
 VOLUME_TOLERANCE = 1e-6  # the script's own toleranceCritical
@@ -42,8 +43,7 @@ def main(argv):
         if a.startswith("--steps="):
             steps = int(a.split("=", 1)[1])
     if not os.path.exists(SCRIPT):
-        print(f"SKIP: {SCRIPT} not found")
-        return 77
+        checks.skip(f"{SCRIPT} not found")
     os.chdir(tempfile.mkdtemp(prefix="pfv-injection-"))  # the script writes ./vtk and Test.txt
     ns = vars(__main__)  # its PyRunner commands are evaluated in __main__
     ns.update(checksPath=os.path.dirname(SCRIPT), YadeCheckError=YadeCheckError, FlowEngine=pfv.FlowEngine)
@@ -52,19 +52,19 @@ def main(argv):
     plot.plot = lambda *a, **k: None  # no GUI
     source = open(SCRIPT).read()
     if "FlowEngine(" not in source:
-        print("FAIL: the script no longer creates a FlowEngine")
-        return 1
+        checks.fail("the script no longer creates a FlowEngine")
+        return
     t0 = time.time()
     try:
         exec(compile(source, SCRIPT, "exec"), ns)
     except Exception:
         traceback.print_exc()
-        print(f"FAIL: the script raised after {time.time() - t0:.0f} s")
-        return 1
+        checks.fail(f"the script raised after {time.time() - t0:.0f} s")
+        return
     engines = [e for e in O.engines if isinstance(e, pfv.FlowEngine)]
     if len(engines) != 1:
-        print(f"FAIL: the script's engines hold {len(engines)} pfv.FlowEngine")
-        return 1
+        checks.fail(f"the script's engines hold {len(engines)} pfv.FlowEngine")
+        return
     flow = engines[0]
     nvoids, bar, level = ns["nvoids"], ns["bar"], ns["initiallevel"]
     dry = [ii for ii in range(nvoids) if bar[ii] >= level]
@@ -76,8 +76,8 @@ def main(argv):
         O.run(steps, True)
     except Exception:
         traceback.print_exc()
-        print(f"FAIL: the imbibition loop raised after {time.time() - t0:.0f} s (O.iter {O.iter})")
-        return 1
+        checks.fail(f"the imbibition loop raised after {time.time() - t0:.0f} s (O.iter {O.iter})")
+        return
     q_in = -ns["Qin"] - ns["deltabubble"]
     total = ns["total"]
     still_dry = sum(1 for ii in dry if flow.getCellPImposed(ii))
@@ -86,7 +86,7 @@ def main(argv):
         f"dry cells {total:.6g}, difference {q_in - total:.3g}; {len(dry) - still_dry} of {len(dry)} dry cells "
         f"filled and freed, {ns['bubble']} bubbles"
     )
-    checks = [
+    rows = [
         (
             "inflow balances the water taken in by the dry cells (|difference| <= 1e-6)",
             abs(q_in - total) <= VOLUME_TOLERANCE,
@@ -101,10 +101,9 @@ def main(argv):
             ),
         ),
     ]
-    failed = [name for name, ok in checks if not ok]
-    for name, ok in checks:
-        print(f"{'ok  ' if ok else 'FAIL'} {name}")
-    return 1 if failed else 0
+    for name, ok in rows:
+        checks.check(name, ok)
 
 
-sys.exit(main(sys.argv[1:]))
+main(sys.argv[1:])
+checks.report("pressure injection")

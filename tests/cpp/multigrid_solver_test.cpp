@@ -331,3 +331,37 @@ TEST(Multigrid, AutoTakesTheFactorUnlessItExceedsTheBudget) {
   EXPECT_EQ(tight.pressure_solver()->kind(), SolverKind::kCholesky);
   EXPECT_EQ(solver_choice(tight).rfind("cholesky: the factor stores", 0), 0u) << solver_choice(tight);
 }
+
+TEST(Multigrid, AutoWeighsTheCostOfTheStepWhereBothFit) {
+  // 29 791 spheres: a factor that fits in any budget here, whose factorisation costs more than
+  // multigrid's hierarchy and first solves, and whose substitution costs less than two CG
+  // iterations (solver_cost.hpp). A remesh at every step: multigrid; YADE's schedule: the factor.
+  const auto p = jittered_lattice(31, 4);
+  FlowEngine often = test::permeameter(0), rarely = test::permeameter(0);
+  often.settings.mesh_update_interval = 1;
+  rarely.settings.mesh_update_interval = 1000;
+  often.step(p.centre, p.radius, p.walls, 1e-3);
+  rarely.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(rarely.pressure_solver()->kind(), SolverKind::kCholesky);
+  EXPECT_NE(solver_choice(rarely).find("below the"), std::string::npos) << solver_choice(rarely);
+  ASSERT_EQ(often.pressure_solver()->kind(), SolverKind::kMultigrid);
+  EXPECT_NE(solver_choice(often).find("beyond which multigrid's step costs less (2 CG iterations per step, 1 steps"),
+            std::string::npos)
+      << solver_choice(often);
+  const double s = spread(rarely.pressure());
+  for (std::size_t c = 0; c < rarely.pressure().size(); ++c)
+    EXPECT_NEAR(often.pressure()[c], rarely.pressure()[c], 2 * often.settings.refinement_tolerance * s);
+  // The next remesh weighs the factor projected then against what the solves showed, and keeps
+  // multigrid without an analysis.
+  often.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(often.pressure_solver()->kind(), SolverKind::kMultigrid);
+  EXPECT_EQ(solver_choice(often), "multigrid: kept from the previous mesh");
+  // On a fixed skeleton multigrid makes one iteration a step, cheaper than the substitution
+  // here: it stays the choice when a system serves many steps.
+  often.settings.mesh_update_interval = 1000;
+  for (int k = 0; k < 3; ++k) often.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(often.last_solve().cg_iterations, 1);
+  often.request_remesh();
+  often.step(p.centre, p.radius, p.walls, 1e-3);
+  EXPECT_EQ(often.pressure_solver()->kind(), SolverKind::kMultigrid);
+}

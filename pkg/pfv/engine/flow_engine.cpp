@@ -145,7 +145,8 @@ void FlowEngine::schedule_remesh(const std::vector<Vec3>& centres, const std::ve
   adopt_finished_remesh();
   if (now || (remesh_due() && !remesher_.pending())) {
     if (settings.background_remesh && !now)
-      remesher_.remesh_in_background(centres, radii, walls, settings, bc, dt, linear_.ordering, auto_keeps_multigrid());
+      remesher_.remesh_in_background(centres, radii, walls, settings, bc, dt, linear_.ordering, auto_keeps_multigrid(),
+                                     history_after(linear_, solve_history_));
     else
       remesh_now(centres, radii, walls, dt);
   }
@@ -158,7 +159,7 @@ void FlowEngine::rebuild_stale_system(double dt) {
   if (linear_.ready() && !system_rebuild_requested_ && !linear_.recipe.stale_for(settings, bc, dt)) return;
   const auto ordering = linear_.ordering;
   linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver(),
-                                {&cells_, &measured_void_volume_});
+                                {&cells_, &measured_void_volume_}, solve_history_);
   ++system_builds_;
   system_rebuild_requested_ = false;
 }
@@ -239,6 +240,7 @@ void FlowEngine::solve() {
       solution_[u] = trend ? 2 * next_pressure_[c] - pressure_before_[c] : next_pressure_[c];
     }
     last_solve_ = solver.solve(rhs_, solution_, settings.solve_control());
+    linear_.tally.add(last_solve_.cg_iterations);
     keep_trend_ = solver.wants_extrapolated_start();  // false once promoted to a double factor
     for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
   }

@@ -186,6 +186,7 @@ class FlowEngine {
 
   std::unique_ptr<PoreMesh> mesh_;
   LinearSystem linear_;
+  SolveHistory solve_history_;  // of the systems before linear_ (solver = auto weighs it)
   Remesher remesher_;
 
   std::vector<double> pressure_, volume_, volume_rate_, rhs_, solution_;

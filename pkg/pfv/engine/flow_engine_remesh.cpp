@@ -39,7 +39,8 @@ void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<
   // the remesh over; the last results stay readable meanwhile.
   remesher_.request();
   const auto ordering = linear_.ordering;  // survives the release of the old factor
-  r.linear = build_linear_system(r.mesh, bc, settings, dt, ordering.get(), released_solver(), {&r.cells});
+  r.linear =
+      build_linear_system(r.mesh, bc, settings, dt, ordering.get(), released_solver(), {&r.cells}, solve_history_);
   adopt(std::move(r.mesh), std::move(r.linear), std::move(r.cells));
   remesher_.restart();  // the schedule starts again
 }
@@ -77,9 +78,14 @@ bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditio
   return carried;
 }
 
-bool FlowEngine::auto_keeps_multigrid() const { return pfv::auto_keeps_multigrid(settings, linear_); }
+bool FlowEngine::auto_keeps_multigrid() const {
+  return pfv::auto_keeps_multigrid(settings, linear_, history_after(linear_, solve_history_));
+}
 
-std::unique_ptr<PressureSolver> FlowEngine::released_solver() { return release_solver(settings, linear_); }
+std::unique_ptr<PressureSolver> FlowEngine::released_solver() {
+  solve_history_ = history_after(linear_, solve_history_);  // before the solver goes
+  return release_solver(settings, linear_, solve_history_);
+}
 
 void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& conditions, bool with_system) {
   // The old pressure at the new pore centres: the state of a compressible fluid, and the warm
@@ -109,6 +115,7 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& 
   t.carry_over = carry_seconds;
   remesh_times_ = t;
   mesh_ = std::make_unique<PoreMesh>(std::move(mesh));
+  solve_history_ = history_after(linear_, solve_history_);
   linear_ = std::move(linear);
   pressure_ = std::move(pressure);
   pressures_solved_ = interpolated;  // else pZero: no history to extrapolate from

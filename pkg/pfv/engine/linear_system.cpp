@@ -105,10 +105,10 @@ CholeskySolver* LinearSystem::cholesky() { return dynamic_cast<CholeskySolver*>(
 
 LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc, const EngineSettings& settings,
                                  double dt, const CellOrdering* previous, std::unique_ptr<PressureSolver> recycled,
-                                 CellState cells) {
+                                 CellState cells, const SolveHistory& history) {
   LinearSystem l;
   l.recipe = SystemRecipe(settings, bc, dt);
-  SolverPlan plan = plan_solver(settings, std::move(recycled));
+  SolverPlan plan = plan_solver(settings, std::move(recycled), history);
   if (settings.fluid_bulk_modulus > 0) {
     const int nc = m.mesh().n_cells();
     const bool measured = cells.void_volume && static_cast<int>(cells.void_volume->size()) == nc;
@@ -157,7 +157,12 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
           return geometric_ordering(*s.matrix, point);
         };
     }
-    l.solver = set_up_solver(std::move(plan), s.matrix, options, settings, t0, l.choice, l.times.analysis);
+    SolverDecision decision;
+    l.solver = set_up_solver(std::move(plan), s.matrix, options, settings, t0, decision);
+    l.choice = std::move(decision.choice);
+    l.times.analysis = decision.analysis;
+    l.factor_values = decision.factor_values;
+    l.multigrid_by_cost = decision.by_cost;
     if (const CholeskySolver* cholesky = l.cholesky()) {
       const CholmodSolver& f = cholesky->factor();
       if (f.ready() && f.permutation())
@@ -172,6 +177,16 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
   l.times.factorization = seconds_since(t0) - l.times.analysis;
   if (l.choice.empty()) l.choice = std::string(to_string(l.solver->kind())) + ": as set";
   return l;
+}
+
+SolveHistory history_after(const LinearSystem& system, SolveHistory before) {
+  const bool multigrid = system.solver && system.solver->kind() == SolverKind::kMultigrid;
+  SolveHistory h = system.tally.history(before, multigrid);
+  if (system.recipe.solver == SolverKind::kAuto && system.solver) {
+    h.factor_values = system.factor_values;
+    h.multigrid_by_cost = system.multigrid_by_cost;
+  }
+  return h;
 }
 
 }  // namespace pfv

@@ -11,6 +11,7 @@
 
 #include "pfv/engine/engine_settings.hpp"
 #include "pfv/engine/pore_mesh.hpp"
+#include "pfv/engine/solver_cost.hpp"
 #include "pfv/engine/stage_times.hpp"
 #include "pfv/linalg/ordering_reuse.hpp"
 #include "pfv/linalg/pressure_solver.hpp"
@@ -61,6 +62,11 @@ struct LinearSystem {
   SystemRecipe recipe;
   // The solver built and why ("multigrid: the Cholesky factor would store ..."), for reports.
   std::string choice;
+  // Under kAuto: the factor values CHOLMOD's analysis projected (0: none), and whether the cost
+  // model rather than the memory refused them (solver_policy.hpp).
+  double factor_values = 0;
+  bool multigrid_by_cost = false;
+  SolveTally tally;  // the steps this system served, multigrid's iterations
   StageTimes times;  // assembly, analysis, factorization
 
   bool ready() const { return solver && (system.n_unknowns() == 0 || solver->ready()); }
@@ -82,9 +88,15 @@ struct CellState {
 // (max_factor_bytes, else the memory available) or CHOLMOD's index range. previous: the ordering of the last
 // factorisation, tried first when settings.reuse_ordering (null: compute one). recycled: the
 // released solver of the previous system, reused (with the storage of its factor's values) if
-// it is of the kind the settings ask for (solver_policy.hpp).
+// it is of the kind the settings ask for (solver_policy.hpp). history: what the solves of the
+// earlier systems showed, which kAuto weighs (solver_cost.hpp).
 LinearSystem build_linear_system(const PoreMesh& mesh, const BoundaryConditions& bc, const EngineSettings& settings,
                                  double dt, const CellOrdering* previous = nullptr,
-                                 std::unique_ptr<PressureSolver> recycled = nullptr, CellState cells = {});
+                                 std::unique_ptr<PressureSolver> recycled = nullptr, CellState cells = {},
+                                 const SolveHistory& history = {});
+
+// The history 'system' leaves after the one it started from: its steps, multigrid's iterations
+// per step if it solved them, and the choice kAuto made for it.
+SolveHistory history_after(const LinearSystem& system, SolveHistory before);
 
 }  // namespace pfv

@@ -35,16 +35,17 @@ void Remesher::cancel() {
 
 void Remesher::remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii,
                                     const BoxWalls& walls, const EngineSettings& settings, const BoundaryConditions& bc,
-                                    double dt, std::shared_ptr<const CellOrdering> ordering, bool keep_multigrid) {
+                                    double dt, std::shared_ptr<const CellOrdering> ordering, bool keep_multigrid,
+                                    const SolveHistory& history) {
   // Snapshot now, build on another thread, carry on with the current mesh meanwhile. The current
   // solver stays in use; an empty multigrid solver stands for it where kAuto keeps that choice
   // (without it the worker would pay the ordering and analysis that decided it again).
   pending_ = Pending{std::async(std::launch::async, [c = centres, r = radii, w = walls, s = settings, b = bc, dt,
-                                                     o = std::move(ordering), keep = keep_multigrid]() {
+                                                     o = std::move(ordering), keep = keep_multigrid, h = history]() {
     PoreMesh m = build_pore_mesh(c, r, w, s);
     CellConditions flat = flat_cells(m, s);
     std::unique_ptr<PressureSolver> recycled = background_stand_in(keep);
-    LinearSystem l = build_linear_system(m, b, s, dt, o.get(), std::move(recycled), {&flat});
+    LinearSystem l = build_linear_system(m, b, s, dt, o.get(), std::move(recycled), {&flat}, h);
     return Remesh{std::move(m), std::move(l), std::move(flat)};
   })};
   strain_ = 0;

@@ -48,10 +48,12 @@ class Remesher {
   void cancel();
   // Snapshot these positions and settings and build their mesh and linear system on another
   // thread; the schedule starts again. ordering: the current factor's (tried first);
-  // keep_multigrid: the current system's multigrid choice stands under kAuto (auto_keeps_multigrid).
+  // keep_multigrid: the current system's multigrid choice stands under kAuto (auto_keeps_multigrid);
+  // history: what the solves so far showed (build_linear_system).
   void remesh_in_background(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                             const EngineSettings& settings, const BoundaryConditions& bc, double dt,
-                            std::shared_ptr<const CellOrdering> ordering, bool keep_multigrid);
+                            std::shared_ptr<const CellOrdering> ordering, bool keep_multigrid,
+                            const SolveHistory& history);
   // The background remesh once it has finished, else nothing. Rethrows what the worker threw,
   // after asking the next step to remesh in the foreground (which then says why).
   std::optional<Remesh> take_finished();

@@ -1,5 +1,6 @@
 #include "pfv/engine/solver_policy.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -93,6 +94,15 @@ std::string refusal_text(const FactorTooLarge& e, const EngineSettings& s) {
   return "the Cholesky factor would store " + bytes_text(e.entries * 8) + ", more than " + limit;
 }
 
+// " beyond which multigrid's step costs less (2 CG iterations per step, 1000 steps per system)"
+std::string cost_text(const CostInputs& c) {
+  char text[160];
+  std::snprintf(text, sizeof text,
+                " beyond which multigrid's step costs less (%.3g CG iterations per step, %.3g steps per system)",
+                c.iterations, c.steps_per_system);
+  return text;
+}
+
 }  // namespace
 
 std::string solver_unavailable(SolverKind kind) {
@@ -114,8 +124,10 @@ bool reads_multigrid_smoother(SolverKind solver) {
   return solver == SolverKind::kMultigrid || solver == SolverKind::kAuto;
 }
 
-SolverPlan plan_solver(const EngineSettings& settings, std::unique_ptr<PressureSolver> recycled) {
+SolverPlan plan_solver(const EngineSettings& settings, std::unique_ptr<PressureSolver> recycled,
+                       const SolveHistory& history) {
   SolverPlan plan;
+  plan.history = history;
   // Under kAuto a multigrid solver carried over keeps the choice made for the earlier mesh of
   // this engine (of a like size): every analysis that would only confirm it costs an ordering.
   plan.automatic = settings.solver == SolverKind::kAuto;
@@ -142,15 +154,23 @@ SolverOptions solver_options(const EngineSettings& settings, const SolverPlan& p
 
 std::unique_ptr<PressureSolver> set_up_solver(SolverPlan plan, std::shared_ptr<const SymmetricMatrix> g,
                                               const SolverOptions& options, const EngineSettings& settings,
-                                              StageClock::time_point start, std::string& choice, double& analysis) {
+                                              StageClock::time_point start, SolverDecision& decision) {
   std::unique_ptr<PressureSolver> solver = std::move(plan.solver);
   if (solver->kind() == SolverKind::kCholesky) {
+    // Under kAuto the factor must also cost less per step than multigrid: a bound on its values
+    // that CHOLMOD's analysis checks like the memory budget.
+    const bool weighs_cost = falls_back(settings);
+    const CostInputs cost = cost_inputs(g->size(), plan.history, settings);
+    const double cost_bound = weighs_cost ? break_even_factor_values(cost) : std::numeric_limits<double>::infinity();
+    SolverOptions bounded = options;
+    bounded.factor.max_entries = std::min(options.factor.max_entries, cost_bound);
     try {
-      solver->setup(g, options);
+      solver->setup(g, bounded);
+      decision.factor_values = static_cast<const CholeskySolver&>(*solver).factor().factor_nonzeros();
       if (plan.automatic)
-        choice = "cholesky: the factor stores " +
-                 bytes_text(static_cast<const CholeskySolver&>(*solver).factor().factor_nonzeros() * 8) +
-                 ", within the budget of " + bytes_text(plan.budget * 8);
+        decision.choice = "cholesky: the factor stores " + bytes_text(decision.factor_values * 8) +
+                          ", within the budget of " + bytes_text(plan.budget * 8) + " and below the " +
+                          bytes_text(cost_bound * 8) + cost_text(cost);
       return solver;
     } catch (const FactorTooLarge& e) {
       if (!falls_back(settings))
@@ -158,26 +178,41 @@ std::unique_ptr<PressureSolver> set_up_solver(SolverPlan plan, std::shared_ptr<c
             "solver='" + std::string(to_string(settings.solver)) + "': " + refusal_text(e, settings) +
             (kMultigridBuilt ? "; use solver='multigrid' (or 'auto', which takes it when the factor does not fit)"
                              : "; PFV was built without hypre (PFV_WITH_HYPRE=OFF): no multigrid solver to take"));
-      choice = "multigrid: " + refusal_text(e, settings);
+      decision.factor_values = e.entries;
+      decision.by_cost = e.why == FactorLimit::kBudget && e.entries <= plan.budget;
+      decision.choice = decision.by_cost ? "multigrid: the Cholesky factor would store " + bytes_text(e.entries * 8) +
+                                               ", more than the " + bytes_text(cost_bound * 8) + cost_text(cost)
+                                         : "multigrid: " + refusal_text(e, settings);
       solver = make_solver(SolverKind::kMultigrid);
-      analysis = seconds_since(start);
+      decision.analysis = seconds_since(start);
     }
   }
-  if (plan.automatic && choice.empty()) choice = "multigrid: kept from the previous mesh";
+  if (plan.automatic && decision.choice.empty()) {  // kept: the last choice stands
+    decision.choice = "multigrid: kept from the previous mesh";
+    decision.factor_values = plan.history.factor_values;
+    decision.by_cost = plan.history.multigrid_by_cost;
+  }
   solver->setup(std::move(g), options);
   return solver;
 }
 
-bool auto_keeps_multigrid(const EngineSettings& settings, const LinearSystem& current) {
-  return settings.solver == SolverKind::kAuto && current.solver && current.solver->kind() == SolverKind::kMultigrid &&
-         current.recipe.max_factor_bytes == settings.max_factor_bytes;
+bool auto_keeps_multigrid(const EngineSettings& settings, const LinearSystem& current, const SolveHistory& history) {
+  if (settings.solver != SolverKind::kAuto || !current.solver || current.solver->kind() != SolverKind::kMultigrid ||
+      current.recipe.max_factor_bytes != settings.max_factor_bytes)
+    return false;
+  if (!current.multigrid_by_cost) return true;  // the memory refused the factor: it still would
+  // The factor projected then, weighed again with what the last system's solves showed.
+  const CostInputs cost = cost_inputs(current.system.n_unknowns(), history, settings);
+  return current.factor_values > break_even_factor_values(cost);
 }
 
-std::unique_ptr<PressureSolver> release_solver(const EngineSettings& settings, LinearSystem& current) {
+std::unique_ptr<PressureSolver> release_solver(const EngineSettings& settings, LinearSystem& current,
+                                               const SolveHistory& history) {
   // Under kAuto a multigrid solver carried over keeps the choice (plan_solver); a new
-  // max_factor_bytes asks for it again.
+  // max_factor_bytes, or a history that makes the factor cheaper, asks for it again.
   const bool drop = settings.solver == SolverKind::kAuto && current.solver &&
-                    current.solver->kind() == SolverKind::kMultigrid && !auto_keeps_multigrid(settings, current);
+                    current.solver->kind() == SolverKind::kMultigrid &&
+                    !auto_keeps_multigrid(settings, current, history);
   auto solver = std::move(current.solver);
   if (solver) solver->release();
   if (drop) solver.reset();

@@ -4,7 +4,7 @@
 
 The 1000-sphere permeameter, pressure 1 on ymin, 0 on ymax, spheres free to move (DEM steps):
   * the default is solver='auto', which picks CHOLMOD here and says so in core.solver_choice;
-    useSolver reads 3 for it;
+    useSolver reads 3 for it, and useSolver=3 selects it (YADE's default direct solver);
   * solver='multigrid' gives the pressures of CHOLMOD within its promise, refinement_tolerance x (max p - min p),
     at every one of 20 DEM steps across remeshes, with each multigrid_smoother; the outflux and the balance of
     wall fluxes against the volume rates within what that promise implies (an error e in the pressures of the
@@ -110,6 +110,9 @@ O.reset()
 flow = rb.fresh()
 rb.check("the default solver is 'auto'", flow.solver == "auto")
 rb.check("solver='auto' reads as useSolver 3", flow.useSolver == 3)
+flow.solver = "cholesky"
+flow.useSolver = 3  # YADE's default direct solver: PFV's default path, not the insisting factor
+rb.check("useSolver=3 selects solver='auto'", flow.solver == "auto", flow.solver)
 rb.run(1)
 rb.check(
     "auto picks CHOLMOD for a small packing",

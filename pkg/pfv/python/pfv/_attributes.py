@@ -55,10 +55,12 @@ CORE_NAME: dict[str, str] = {
 }
 
 # YADE's useSolver numbers and the core's solver names (YADE's 2, Taucs, has no counterpart).
-_SOLVER_OF_USE_SOLVER: dict[int, str] = {0: "gauss_seidel", 1: "conjugate_gradient", 3: "cholesky"}
-# solver="auto" (the default) reads as 3: it is CHOLMOD unless the factor would not fit. The
-# multigrid solver has no YADE number (YADE's 4 is its GPU CHOLMOD) and reads as -1.
-_USE_SOLVER_OF: dict[str, int] = {**{v: k for k, v in _SOLVER_OF_USE_SOLVER.items()}, "auto": 3, "multigrid": -1}
+# YADE's 3, its default direct solver, is PFV's default too: "auto", the factor unless it would
+# not fit or multigrid's step costs less (doc/solvers.md); solver="cholesky" insists on the factor.
+_SOLVER_OF_USE_SOLVER: dict[int, str] = {0: "gauss_seidel", 1: "conjugate_gradient", 3: "auto"}
+# Both of PFV's direct paths read as 3. The multigrid solver has no YADE number (YADE's 4 is its
+# GPU CHOLMOD) and reads as -1.
+_USE_SOLVER_OF: dict[str, int] = {**{v: k for k, v in _SOLVER_OF_USE_SOLVER.items()}, "cholesky": 3, "multigrid": -1}
 
 
 def is_yade_attribute(name: str) -> bool:
@@ -109,7 +111,9 @@ def unknown_attribute(name: str, setting: bool) -> AttributeError:
 def solver_of_use_solver(value: int) -> str:
     """The core's solver name for YADE's useSolver number."""
     if value not in _SOLVER_OF_USE_SOLVER:
-        raise ValueError("useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG, PFV) or 3 (CHOLMOD)")
+        raise ValueError(
+            "useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG, PFV) or 3 (CHOLMOD, as solver='auto')"
+        )
     return _SOLVER_OF_USE_SOLVER[value]
 
 

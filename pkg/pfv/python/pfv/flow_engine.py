@@ -205,8 +205,9 @@ class FlowEngine(PyRunner):
 
     @property
     def useSolver(self) -> int:
-        """YADE's solver number: 0 Gauss-Seidel, 1 conjugate gradients (PFV), 3 CHOLMOD (also for
-        solver='auto'), -1 for solver='multigrid', which YADE lacks."""
+        """YADE's solver number: 0 Gauss-Seidel, 1 conjugate gradients (PFV), 3 the direct solve (solver='auto',
+        PFV's default, which takes multigrid where the factor would not fit or its step costs more; also read for
+        solver='cholesky'), -1 for solver='multigrid', which YADE lacks. Setting 3 sets solver='auto'."""
         return attributes.use_solver_of(self._core.solver)
 
     @useSolver.setter

@@ -86,15 +86,19 @@ TEST(SolverCost, ASystemLeavesItsStepsAndIterations) {
   EXPECT_EQ(SolveTally{}.history(before, true).steps_per_system, 50);  // never solved: nothing learnt
 }
 
-TEST(SolverCost, InputsFollowTheHistoryThenTheSchedule) {
+TEST(SolverCost, InputsFollowTheScheduleAndTheHistory) {
   EngineSettings s;
   s.mesh_update_interval = 1000;
   CostInputs in = cost_inputs(1e5, SolveHistory{}, s);
   EXPECT_DOUBLE_EQ(in.iterations, kAssumedMultigridIterations);
   EXPECT_DOUBLE_EQ(in.steps_per_system, 1000);
   in = cost_inputs(1e5, SolveHistory{0.5, 30}, s);
-  EXPECT_DOUBLE_EQ(in.iterations, 1);  // at least one iteration a step
-  EXPECT_DOUBLE_EQ(in.steps_per_system, 30);
+  EXPECT_DOUBLE_EQ(in.iterations, 1);           // at least one iteration a step
+  EXPECT_DOUBLE_EQ(in.steps_per_system, 1000);  // a system cut short by a requested remesh: the schedule
+  s.def_tolerance = 0.01;                       // the strain criterion: the steps seen
+  EXPECT_DOUBLE_EQ(cost_inputs(1e5, SolveHistory{0.5, 30}, s).steps_per_system, 30);
+  EXPECT_DOUBLE_EQ(cost_inputs(1e5, SolveHistory{0.5, 3000}, s).steps_per_system, 1000);
   s.mesh_update_interval = 0;  // no scheduled remesh
+  s.def_tolerance = 0;
   EXPECT_GT(cost_inputs(1e5, SolveHistory{}, s).steps_per_system, 1e5);
 }

@@ -45,9 +45,12 @@ CostInputs cost_inputs(double unknowns, const SolveHistory& history, const Engin
   CostInputs in;
   in.unknowns = unknowns;
   if (history.multigrid_iterations >= 0) in.iterations = std::max(1.0, history.multigrid_iterations);
-  in.steps_per_system = history.steps_per_system > 0        ? static_cast<double>(history.steps_per_system)
-                        : settings.mesh_update_interval > 0 ? settings.mesh_update_interval
-                                                            : kNeverRemeshed;
+  // The schedule says how long a system lives; with the strain criterion on, the steps the last
+  // system served say it better. A remesh asked for by the caller (or a change of the boundary
+  // conditions) ends a system early without saying anything about the next one.
+  in.steps_per_system = settings.mesh_update_interval > 0 ? settings.mesh_update_interval : kNeverRemeshed;
+  if (settings.def_tolerance > 0 && history.steps_per_system > 0)
+    in.steps_per_system = std::min(in.steps_per_system, static_cast<double>(history.steps_per_system));
   in.steps_per_system = std::clamp(in.steps_per_system, 1.0, kNeverRemeshed);
   in.smoother = settings.multigrid_smoother;
   return in;

@@ -2,7 +2,7 @@
 // both fit in memory: the time per DEM step of each, its set-up (factorisation, hierarchy)
 // spread over the steps a system serves. It counts only what the engine knows exactly (the
 // factor's values from CHOLMOD's analysis, the unknowns, multigrid's CG iterations per step seen
-// on the last system, the steps a system served), weighted by per-unit costs measured on the
+// on the last system, the remesh schedule), weighted by per-unit costs measured on the
 // benchmark lattice at one thread (doc/solvers.md, "solver = auto"): the choice is the same on
 // every run of a scene, whatever the machine's load, and only the ratio of the weights matters.
 #pragma once
@@ -14,7 +14,7 @@ namespace pfv {
 struct SolveHistory {
   // Multigrid's CG iterations per step after the first on the last system it solved; < 0: none seen.
   double multigrid_iterations = -1;
-  long steps_per_system = 0;  // steps the last system served; 0: no system yet
+  long steps_per_system = 0;  // steps the last system served (weighed with defTolerance on); 0: none
   // Under kAuto, the last choice: the factor values its analysis projected (0: none) and whether
   // the cost model, not the memory, refused that factor.
   double factor_values = 0;

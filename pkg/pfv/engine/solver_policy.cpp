@@ -98,7 +98,7 @@ std::string refusal_text(const FactorTooLarge& e, const EngineSettings& s) {
 std::string cost_text(const CostInputs& c) {
   char text[160];
   std::snprintf(text, sizeof text,
-                " beyond which multigrid's step costs less (%.3g CG iterations per step, %.3g steps per system)",
+                " beyond which multigrid's step costs less (%.3g CG iterations per step, %.4g steps per system)",
                 c.iterations, c.steps_per_system);
   return text;
 }

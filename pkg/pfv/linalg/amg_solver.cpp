@@ -6,6 +6,7 @@ namespace pfv {
 
 AmgParameters amg_parameters(MultigridSmoother smoother) {
   AmgParameters parameters;
+  parameters.start_history = kEngineStartHistory;
   if (smoother == MultigridSmoother::kJacobi) parameters.relax_type = 18;  // l1-scaled Jacobi
   if (smoother == MultigridSmoother::kSplitGaussSeidel) {
     parameters.relax_down = 13;  // l1-scaled Gauss-Seidel, forwards

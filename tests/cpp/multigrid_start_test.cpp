@@ -110,7 +110,9 @@ TEST(MultigridStart, TheHistoryNeedsFewerIterationsThanTheLinearStart) {
       old_total += old_iterations;
       new_total += new_iterations;
     }
-    if (k >= 5) EXPECT_EQ(new_iterations, 1) << "step " << k;
+    if (k >= 5) {
+      EXPECT_EQ(new_iterations, 1) << "step " << k;
+    }
     old_text += ' ' + std::to_string(old_iterations);
     new_text += ' ' + std::to_string(new_iterations);
   }
@@ -143,16 +145,17 @@ TEST(MultigridStart, ADroppedSolutionLeavesTheHistory) {
   std::vector<double> x4(x3);
   amg.solve(b[2], x4, 1e-10, 1000);
   EXPECT_EQ(amg.kept_solutions(), 3);
-  std::vector<double> other(x3);  // pressures changed by the caller: kept with their product
+  std::vector<double> other(x4);  // pressures changed by the caller: the history starts from them
   other[0] += 1;
   amg.solve(b[2], other, 1e-10, 1000);
-  EXPECT_EQ(amg.kept_solutions(), 3);
+  EXPECT_EQ(amg.kept_solutions(), 2);
 }
 
 // The engine with multigrid against the direct solve, every sphere drifting at its own constant
-// velocity: at every step within refinement_tolerance of the spread, through a changed time step,
-// a remesh (the history starts again on the new system from the interpolated pressures) and, for a
-// compressible fluid, the rebuilt system a changed time step makes.
+// velocity: at every step within refinement_tolerance of the spread, through a changed time step
+// (extrapolated in time), a remesh (the history starts again on the new system from the
+// interpolated pressures) and, for a compressible fluid, the rebuilt system a changed time step
+// makes.
 TEST(MultigridStart, KeepsTheBoundInADriftingLattice) {
   for (const double bulk_modulus : {0.0, 1e3}) {
     SCOPED_TRACE(bulk_modulus);
@@ -184,11 +187,16 @@ TEST(MultigridStart, KeepsTheBoundInADriftingLattice) {
       EXPECT_LE(error, bound) << "step " << step;
       worst_ratio = std::max(worst_ratio, error / bound);
       const int n = multigrid.last_solve().cg_iterations;
-      // Incompressible, three steps after the start, the change of dt and the remesh the history
-      // predicts the step again: one iteration. (A compressible fluid's pressures relax from
-      // p = 0 through the run, which no extrapolation predicts.)
-      if (bulk_modulus == 0 && (step == 5 || step == 9 || step == 10 || step == 14 || step == 15))
+      // Incompressible: the history extrapolates in time through the change of dt (at most two
+      // iterations) and predicts the step again, one iteration, three steps after the start and
+      // after the remesh. (A compressible fluid's pressures relax from p = 0 through the run,
+      // which no extrapolation predicts.)
+      if (bulk_modulus == 0 && (step == 5 || step == 9 || step == 10 || step == 14 || step == 15)) {
         EXPECT_EQ(n, 1) << "step " << step;
+      }
+      if (bulk_modulus == 0 && step >= 6 && step <= 8) {
+        EXPECT_LE(n, 2) << "step " << step;
+      }
       iterations += ' ' + std::to_string(n);
     }
     EXPECT_EQ(multigrid.remesh_count(), 2);

@@ -107,12 +107,12 @@ struct AmgPcg::Impl {
         history(c, count, kept_solutions) {}
 
   // x <- the start from the history and x, the caller's start (solution_history.hpp).
-  void start_from_history() {
+  void start_from_history(double step) {
     if (history.adopt_start(x.data)) {
       HYPRE_ParCSRMatrixMatvec(1.0, a, x.par, 0.0, q.par);  // G x, once per start the history lacks
       history.add(x.data, q.data);
     }
-    history.predict(b.data, x.data);
+    history.predict(b.data, x.data, step);
   }
 
   void precondition() const {  // z = M^-1 r: one V-cycle from zero
@@ -240,14 +240,14 @@ std::array<int, 2> AmgPcg::cycle_relax_types() const {
   return {static_cast<int>(type[1]), static_cast<int>(type[2])};  // [1] down, [2] up ([0] fine, [3] coarsest)
 }
 
-AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x, double tolerance,
-                            int max_iterations) {
+AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x, double tolerance, int max_iterations,
+                            double step) {
   Impl& m = *impl_;
   if (static_cast<int>(b.size()) != m.n || static_cast<int>(x.size()) != m.n)
     throw std::invalid_argument("the multigrid solve needs one value of b and x per local row");
   std::copy(b.begin(), b.end(), m.b.begin());
   std::copy(x.begin(), x.end(), m.x.begin());
-  m.start_from_history();
+  m.start_from_history(step);
   constexpr double kNegligibleUpdate = 1e-3, kSeedSafety = 2;
   double previous = 0, largest = 0;
   const auto stop = [&](int k, double alpha) {
@@ -286,7 +286,7 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
   stats.converged = k >= 0;
   stats.iterations = k >= 0 ? k : max_iterations;
   if (stats.iterations >= 3) seen_ratio_ = largest;
-  m.history.add_provisional(m.x.data, m.b.data, m.r.data);
+  m.history.add_provisional(m.x.data, m.b.data, m.r.data, step);
   std::copy(m.x.begin(), m.x.end(), x.begin());
   return stats;
 }

@@ -96,7 +96,9 @@ class AmgPcg {
   // pressures the history lacks) and the solve starts from the history's extrapolation; the
   // solution is kept provisionally: a caller that passes it back as the next start confirms it,
   // one that passes other values (it dropped the step) removes it. Collective.
-  AmgSolveStats solve(const std::vector<double>& b, std::vector<double>& x, double tolerance, int max_iterations);
+  // step: the time since the last solve (the DEM step), for the history's extrapolation in time.
+  AmgSolveStats solve(const std::vector<double>& b, std::vector<double>& x, double tolerance, int max_iterations,
+                      double step = 1);
   // Stops at |b - G x| <= relative_residual |b| instead; x = 0 on entry gives G^-1 b.
   AmgSolveStats solve_to_residual(const std::vector<double>& b, std::vector<double>& x, double relative_residual,
                                   int max_iterations) const;

@@ -26,7 +26,7 @@ void AmgSolver::setup(const SymmetricMatrix& g, const AmgParameters& parameters)
 }
 
 SolveStats AmgSolver::solve(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) {
-  const AmgSolveStats s = pcg_->solve(b, x, control.refinement_tolerance, control.max_iterations);
+  const AmgSolveStats s = pcg_->solve(b, x, control.refinement_tolerance, control.max_iterations, control.time_step);
   SolveStats stats;
   stats.cg_iterations = s.iterations;
   stats.converged = s.converged;

@@ -110,7 +110,7 @@ struct AmgPcg::Impl {
   void start_from_history(double step) {
     if (history.adopt_start(x.data)) {
       HYPRE_ParCSRMatrixMatvec(1.0, a, x.par, 0.0, q.par);  // G x, once per start the history lacks
-      history.add(x.data, q.data);
+      history.add(x.data, q.data, step);
     }
     history.predict(b.data, x.data, step);
   }

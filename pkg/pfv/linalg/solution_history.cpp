@@ -59,12 +59,12 @@ bool SolutionHistory::adopt_start(const double* start) {
   return zero == 0;
 }
 
-void SolutionHistory::add(const double* x, const double* gx) {
+void SolutionHistory::add(const double* x, const double* gx, double step) {
   if (capacity() == 0) return;
   const double t = count_ > 0 ? time_[head_] : 0;
   head_ = (head_ + 1) % capacity();
   time_[head_] = t;
-  step_[head_] = 0;
+  step_[head_] = step;
   count_ = std::min(count_ + 1, capacity());
   std::copy(x, x + n_, x_[head_].begin());
   std::copy(gx, gx + n_, gx_[head_].begin());

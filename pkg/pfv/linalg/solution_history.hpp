@@ -41,8 +41,8 @@ class SolutionHistory {
   // with G (add()). Collective.
   bool adopt_start(const double* start);
   // x and G x, as the newest entry, at the instant of the newest (the oldest goes once capacity()
-  // are kept).
-  void add(const double* x, const double* gx);
+  // are kept), the solution of a step of this length (the caller's last step; taken as the next).
+  void add(const double* x, const double* gx, double step);
   // The solution of a solve just finished, step after the newest entry, with G x = b - r (r its
   // residual): the newest entry until adopt_start() finds the next start is not it. Entries that
   // are not finite are not kept.
@@ -61,8 +61,7 @@ class SolutionHistory {
   int n_;
   std::vector<std::vector<double>> x_, gx_;  // a ring, the newest at head_
   // The end of each entry's step, from the first kept, and the step. A solution stands for the
-  // middle of its step: the volume rates are differences over the step (the first entry, and one
-  // the caller handed in, for the end).
+  // middle of its step: the volume rates are differences over the step.
   std::vector<double> time_, step_;
   int head_ = 0, count_ = 0;
   bool provisional_ = false;

@@ -249,7 +249,13 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
   std::copy(x.begin(), x.end(), m.x.begin());
   m.start_from_history(step);
   constexpr double kNegligibleUpdate = 1e-3, kSeedSafety = 2;
+  // The first solve on a system goes on to kMeasuringTolerance at least, for a contraction
+  // measured over enough iterations to hold for the later solves (a loose tolerance stops a solve
+  // while its ratios are still those of the first updates, far below the contraction to come).
+  constexpr double kMeasuringTolerance = 1e-8;
+  if (seen_ratio_ == 0) tolerance = std::min(tolerance, kMeasuringTolerance);
   double previous = 0, largest = 0;
+  int ratios = 0;  // since the estimate last started
   const auto stop = [&](int k, double alpha) {
     double d = 0, lo = m.x.data[0], hi = m.x.data[0], size = 0;
     for (int i = 0; i < m.n; ++i) {
@@ -278,6 +284,10 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
     // An update larger than the one before: the iteration is not contracting (yet), so the
     // ratios so far say nothing about the error; the estimate starts again from the next one.
     largest = ratio < 1 ? std::max(largest, ratio) : 0;
+    ratios = ratio < 1 ? ratios + 1 : 0;
+    // One ratio alone is no estimate on a system without a measured one: the first ratio of a
+    // solve is often far below the contraction that follows.
+    if (ratios < 2 && seen_ratio_ == 0) return false;
     const double rho = largest > 0 ? std::max(largest, seen_ratio_) : 0;
     return rho > 0 && rho < 1 && rho / (1 - rho) * d <= bound;
   };

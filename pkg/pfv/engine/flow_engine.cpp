@@ -121,7 +121,7 @@ void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double
     strain = assemble(centres, walls, dt);
   }
   assemble_rhs();
-  solve();
+  solve(dt);
   compute_forces(centres, radii, dt);
   commit(centres, walls, strain);
   step_times_.total = seconds_since(start);
@@ -222,7 +222,7 @@ void FlowEngine::assemble_rhs() {
   pfv::assemble_rhs(system, terms, next_pressure_, rhs_);
 }
 
-void FlowEngine::solve() {
+void FlowEngine::solve(double dt) {
   const auto t0 = StageClock::now();
   const PressureSystem& system = linear_.system;
   const int nu = system.n_unknowns();
@@ -239,7 +239,9 @@ void FlowEngine::solve() {
       const int c = system.unknown_cell[u];
       solution_[u] = trend ? 2 * next_pressure_[c] - pressure_before_[c] : next_pressure_[c];
     }
-    last_solve_ = solver.solve(rhs_, solution_, settings.solve_control());
+    SolveControl control = settings.solve_control();
+    control.time_step = dt;  // multigrid's start: extrapolated in time
+    last_solve_ = solver.solve(rhs_, solution_, control);
     linear_.tally.add(last_solve_.cg_iterations);
     keep_trend_ = solver.wants_extrapolated_start();  // false once promoted to a double factor
     for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];

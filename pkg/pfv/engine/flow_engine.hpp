@@ -157,7 +157,7 @@ class FlowEngine {
   void rebuild_stale_system(double dt);
   double assemble(const std::vector<Vec3>& centres, const BoxWalls& walls, double dt);  // returns the pore strain
   void assemble_rhs();  // once per step, on the mesh the step solves on (pressure_rhs.hpp)
-  void solve();
+  void solve(double dt);
   void compute_forces(const std::vector<Vec3>& centres, const std::vector<double>& radii, double dt);
   void commit(const std::vector<Vec3>& centres, const BoxWalls& walls, double strain);
 

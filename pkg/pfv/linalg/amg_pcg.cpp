@@ -12,6 +12,8 @@
 #include <string>
 #include <type_traits>
 
+#include "pfv/linalg/solution_history.hpp"
+
 namespace pfv {
 namespace {
 
@@ -90,8 +92,9 @@ struct AmgPcg::Impl {
   SolverHandle amg;
   // b, x and the iteration's residual, preconditioned residual, direction and G times it.
   mutable WorkVector b, x, r, z, p, q;
+  SolutionHistory history;  // the last solutions, for the start of the next solve
 
-  Impl(MPI_Comm c, int first_row, int count)
+  Impl(MPI_Comm c, int first_row, int count, int kept_solutions)
       : comm(c),
         first(first_row),
         n(count),
@@ -100,7 +103,17 @@ struct AmgPcg::Impl {
         r(c, first_row, count),
         z(c, first_row, count),
         p(c, first_row, count),
-        q(c, first_row, count) {}
+        q(c, first_row, count),
+        history(c, count, kept_solutions) {}
+
+  // x <- the start from the history and x, the caller's start (solution_history.hpp).
+  void start_from_history(double step) {
+    if (history.adopt_start(x.data)) {
+      HYPRE_ParCSRMatrixMatvec(1.0, a, x.par, 0.0, q.par);  // G x, once per start the history lacks
+      history.add(x.data, q.data, step);
+    }
+    history.predict(b.data, x.data, step);
+  }
 
   void precondition() const {  // z = M^-1 r: one V-cycle from zero
     std::fill(z.begin(), z.end(), 0.0);
@@ -155,8 +168,11 @@ AmgPcg::AmgPcg(MPI_Comm comm, const DistributedRows& rows, const AmgParameters& 
     throw std::invalid_argument("the rows given to the multigrid solver are inconsistent");
   for (int c : rows.column)
     if (c < 0 || c >= rows.global_rows) throw std::invalid_argument("a column index is outside the matrix");
+  if (parameters.start_history < 0 || parameters.start_history > AmgParameters::kMaxStartHistory)
+    throw std::invalid_argument("the multigrid solver keeps 0 to " + std::to_string(AmgParameters::kMaxStartHistory) +
+                                " solutions for its start");
   ensure_hypre_initialized();
-  impl_ = std::make_unique<Impl>(comm, rows.first_row, n);
+  impl_ = std::make_unique<Impl>(comm, rows.first_row, n, parameters.start_history);
   Impl& m = *impl_;
 
   HYPRE_IJMatrix ij = nullptr;
@@ -217,20 +233,29 @@ AmgPcg::~AmgPcg() = default;
 
 int AmgPcg::levels() const { return hypre_ParAMGDataNumLevels(reinterpret_cast<hypre_ParAMGData*>(impl_->amg.get())); }
 
+int AmgPcg::kept_solutions() const { return impl_->history.size(); }
+
 std::array<int, 2> AmgPcg::cycle_relax_types() const {
   const HYPRE_Int* type = hypre_ParAMGDataGridRelaxType(reinterpret_cast<hypre_ParAMGData*>(impl_->amg.get()));
   return {static_cast<int>(type[1]), static_cast<int>(type[2])};  // [1] down, [2] up ([0] fine, [3] coarsest)
 }
 
-AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x, double tolerance,
-                            int max_iterations) {
+AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x, double tolerance, int max_iterations,
+                            double step) {
   Impl& m = *impl_;
   if (static_cast<int>(b.size()) != m.n || static_cast<int>(x.size()) != m.n)
     throw std::invalid_argument("the multigrid solve needs one value of b and x per local row");
   std::copy(b.begin(), b.end(), m.b.begin());
   std::copy(x.begin(), x.end(), m.x.begin());
+  m.start_from_history(step);
   constexpr double kNegligibleUpdate = 1e-3, kSeedSafety = 2;
+  // The first solve on a system goes on to kMeasuringTolerance at least, for a contraction
+  // measured over enough iterations to hold for the later solves (a loose tolerance stops a solve
+  // while its ratios are still those of the first updates, far below the contraction to come).
+  constexpr double kMeasuringTolerance = 1e-8;
+  if (seen_ratio_ == 0) tolerance = std::min(tolerance, kMeasuringTolerance);
   double previous = 0, largest = 0;
+  int ratios = 0;  // since the estimate last started
   const auto stop = [&](int k, double alpha) {
     double d = 0, lo = m.x.data[0], hi = m.x.data[0], size = 0;
     for (int i = 0; i < m.n; ++i) {
@@ -245,24 +270,33 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
     d = global[0];
     const double spread = global[1] + global[2] > 0 ? global[1] + global[2] : global[3];
     const double bound = tolerance * spread;
-    if (d <= kNegligibleUpdate * bound) return true;
     if (k == 1) {
+      // Only a contraction measured on this system certifies the first update, however small:
+      // a start the history predicted well leaves a small update, which says nothing of the
+      // error left in what the V-cycle reduces slowly.
       previous = d;
       const double seed = kSeedSafety * seen_ratio_;
       return seed > 0 && seed < 1 && seed / (1 - seed) * d <= bound;
     }
+    if (d <= kNegligibleUpdate * bound) return true;
     const double ratio = d / previous;
     previous = d;
     // An update larger than the one before: the iteration is not contracting (yet), so the
     // ratios so far say nothing about the error; the estimate starts again from the next one.
     largest = ratio < 1 ? std::max(largest, ratio) : 0;
-    return largest > 0 && largest / (1 - largest) * d <= bound;
+    ratios = ratio < 1 ? ratios + 1 : 0;
+    // One ratio alone is no estimate on a system without a measured one: the first ratio of a
+    // solve is often far below the contraction that follows.
+    if (ratios < 2 && seen_ratio_ == 0) return false;
+    const double rho = largest > 0 ? std::max(largest, seen_ratio_) : 0;
+    return rho > 0 && rho < 1 && rho / (1 - rho) * d <= bound;
   };
   AmgSolveStats stats;
   const int k = m.iterate(max_iterations, stop);
   stats.converged = k >= 0;
   stats.iterations = k >= 0 ? k : max_iterations;
-  if (stats.iterations >= 2) seen_ratio_ = largest;
+  if (stats.iterations >= 3) seen_ratio_ = largest;
+  m.history.add_provisional(m.x.data, m.b.data, m.r.data, step);
   std::copy(m.x.begin(), m.x.end(), x.begin());
   return stats;
 }

@@ -6,6 +6,7 @@ namespace pfv {
 
 AmgParameters amg_parameters(MultigridSmoother smoother) {
   AmgParameters parameters;
+  parameters.start_history = kEngineStartHistory;
   if (smoother == MultigridSmoother::kJacobi) parameters.relax_type = 18;  // l1-scaled Jacobi
   if (smoother == MultigridSmoother::kSplitGaussSeidel) {
     parameters.relax_down = 13;  // l1-scaled Gauss-Seidel, forwards
@@ -25,7 +26,7 @@ void AmgSolver::setup(const SymmetricMatrix& g, const AmgParameters& parameters)
 }
 
 SolveStats AmgSolver::solve(const std::vector<double>& b, std::vector<double>& x, const SolveControl& control) {
-  const AmgSolveStats s = pcg_->solve(b, x, control.refinement_tolerance, control.max_iterations);
+  const AmgSolveStats s = pcg_->solve(b, x, control.refinement_tolerance, control.max_iterations, control.time_step);
   SolveStats stats;
   stats.cg_iterations = s.iterations;
   stats.converged = s.converged;

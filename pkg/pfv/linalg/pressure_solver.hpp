@@ -37,6 +37,8 @@ struct SolveControl {
   // apply_inverse of the iterative solvers: |r|/|b| (Gauss-Seidel: max|dx|/max|x|). The
   // eigenvalue estimates need it tight; a caller that certifies its own result may loosen it.
   double inverse_tolerance = 1e-10;
+  // The time since the last solve (the DEM step): multigrid extrapolates its start in time.
+  double time_step = 1;
 };
 
 // What the last solve did, each count named for what it counts.

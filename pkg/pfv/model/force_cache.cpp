@@ -63,7 +63,6 @@ void ForceCache::apply(const std::vector<double>& p, std::vector<Vec3>& force) c
 void ForceCache::apply_magnitude(const std::vector<double>& value, std::vector<Vec3>& bound) const {
   const int nv = n_vertices();
   bound.resize(nv);
-#pragma omp parallel for schedule(static) if (start_[nv] > kMinParallelLoop)
   for (int v = 0; v < nv; ++v) {
     Vec3 b = Vec3::Zero();
     for (int e = start_[v]; e < start_[v + 1]; ++e) b += value[cell_[e]] * unit_[e].cwiseAbs();

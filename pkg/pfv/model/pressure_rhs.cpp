@@ -4,7 +4,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "pfv/common/parallel.hpp"
 #include "pfv/snapshot/snapshot.hpp"
 
 namespace pfv {
@@ -58,15 +57,9 @@ void assemble_rhs(const PressureSystem& s, const RhsTerms& t, const std::vector<
                   std::vector<double>& rhs) {
   const int nu = s.n_unknowns();
   rhs.resize(nu);
-  // Row by row, each written by one thread: the same sum in the same order on any number.
-  const bool stored = !t.storage.empty();
-#pragma omp parallel for schedule(static) if (nu > kMinParallelLoop)
-  for (int u = 0; u < nu; ++u) {
-    const int c = s.unknown_cell[u];
-    rhs[u] = stored ? -t.volume_rate[c] + t.storage[c] * t.pressure[c] : -t.volume_rate[c];
-  }
-  // The imposed fluxes and the Dirichlet couplings are boundary terms (and may add to one row
-  // twice): on one thread.
+  for (int u = 0; u < nu; ++u) rhs[u] = -t.volume_rate[s.unknown_cell[u]];
+  if (!t.storage.empty())
+    for (int u = 0; u < nu; ++u) rhs[u] += t.storage[s.unknown_cell[u]] * t.pressure[s.unknown_cell[u]];
   for (std::size_t i = 0; i < t.imposed_flux_cells.size(); ++i) {
     const int c = t.imposed_flux_cells[i];
     if (c >= 0 && s.unknown[c] >= 0) rhs[s.unknown[c]] += t.imposed_flux[i].value;

@@ -171,6 +171,65 @@ def print_row(n, solver, stage, one, two, note=''):
     print(ROW % (n, solver, stage, '%.2f' % m1, r1, '%.2f' % m2, r2, x, best) + note, flush=True)
 
 
+# The stages the model extrapolates: (name, where its times are, bandwidth-bound, structural serial fraction, most
+# threads it can use). The structural fractions are those of the code: dV/dt and the forces are single loops over
+# cells and vertices on the team; the rest of the core's step and the exchange with YADE run on one thread; the
+# Cholesky solve is the substitution, planned for two groups of subtrees (ParallelSubstitution::plan(view, 2)), and
+# the refinement's residual, both on the team (its O(n) vector operations are left out); hypre's multigrid has no
+# OpenMP (Debian's build). Bandwidth-bound: the Cholesky solve streams the factor and the forces stream S (28 bytes
+# per two flops); dV/dt computes a determinant per cell from four gathered centres.
+MODEL_STAGES = (
+    ('volumes', 'core', False, {'cholesky': 0.0, 'multigrid': 0.0}, None),
+    ('solve', 'core', True, {'cholesky': 0.0, 'multigrid': 1.0}, {'cholesky': 2}),
+    ('forces', 'core', True, {'cholesky': 0.0, 'multigrid': 0.0}, None),
+    ('rest', 'core', True, {'cholesky': 1.0, 'multigrid': 1.0}, None),
+    ('read positions', 'exchange', True, {'cholesky': 1.0, 'multigrid': 1.0}, None),
+    ('add forces', 'exchange', False, {'cholesky': 1.0, 'multigrid': 1.0}, None),
+)
+CORES = (1, 2, 8, 16, 32, 64)
+
+
+def fitted_fraction(one, two):
+    """Amdahl's s from the best rounds at one and two threads: t2 / t1 = s + (1 - s) / 2."""
+    return min(1.0, max(0.0, 2 * min(two) / min(one) - 1))
+
+
+def modelled_step(stages, cores, bandwidth_cores):
+    """The flow step at `cores` threads: per stage its one-thread median times s + (1 - s) / p, p capped where the
+    stage can use no more threads, and not below 1 / bandwidth_cores of it where the stage streams memory (the cores
+    one socket's memory bandwidth feeds)."""
+    total = 0.0
+    for t1, s, cap, bound in stages:
+        p = min(cores, cap) if cap else cores
+        factor = s + (1 - s) / p
+        if bound:
+            factor = max(factor, 1.0 / bandwidth_cores)
+        total += t1 * factor
+    return total
+
+
+def print_model(n, solver, times, exchange, bandwidth_cores):
+    """Two models of the flow step (core step and exchange) against cores: Amdahl's serial fractions fitted to the
+    best rounds at one and two threads, and those of the code's structure."""
+    fitted, structural, names = [], [], []
+    for name, where, bound, serial, cap in MODEL_STAGES:
+        source = times if where == 'core' else exchange
+        if not source:
+            continue
+        one, two = source[1][name], source[2][name]
+        t1, s = statistics.median(one), fitted_fraction(one, two)
+        names.append('%s %.2f' % (name, s))
+        fitted.append((t1, s, None, bound))
+        structural.append((t1, serial[solver], (cap or {}).get(solver), bound))
+    for label, stages in (('fitted (%s)' % ', '.join(names), fitted), ('structural', structural)):
+        base = modelled_step(stages, 1, bandwidth_cores)
+        predicted = ', '.join(
+            '%d: %.1f ms (%.2fx)' % (p, t * 1e3, base / t)
+            for p, t in ((p, modelled_step(stages, p, bandwidth_cores)) for p in CORES)
+        )
+        print('model %d %s, %s: %s' % (n, solver, label, predicted), flush=True)
+
+
 def main(argv):
     if option(argv, 'child', '') == 'exchange':
         exchange_child(int(float(option(argv, 'n', 10000))), int(option(argv, 'rounds', 7)))
@@ -179,18 +238,25 @@ def main(argv):
     solvers = option_list(argv, 'solvers', 'cholesky,multigrid')
     rounds = int(option(argv, 'rounds', 7))
     exchange = int(option(argv, 'exchange', 1))
+    bandwidth_cores = float(option(argv, 'bandwidth_cores', 8.0))
     print(ROW % ('N', 'solver', 'stage', '1 thr, ms', 'range', '2 thr, ms', 'range', 'x', 'best'))
     print(ROW % tuple('-' * w for w in (7, 9, 14, 9, 15, 9, 15, 4, 4)))
+    measured = []
     for n in sizes:
+        cores = {}
         for solver in solvers:
             times, diff = core_rows(n, solver, rounds)
+            cores[solver] = times
             for s in STAGES:
                 note = '  (1 vs 2 threads: max rel. diff %.1e)' % diff if s == 'Engine.step' else ''
                 print_row(n, solver, s, times[1][s], times[2][s], note)
-        if exchange:
-            ex = exchange_rows(n, rounds)
-            for s in EXCHANGE:
-                print_row(n, 'YADE', s, ex[1][s], ex[2][s])
+        ex = exchange_rows(n, rounds) if exchange else None
+        for s in EXCHANGE if ex else ():
+            print_row(n, 'YADE', s, ex[1][s], ex[2][s])
+        measured += [(n, solver, times, ex) for solver, times in cores.items()]
+    print()
+    for n, solver, times, ex in measured:
+        print_model(n, solver, times, ex, bandwidth_cores)
 
 
 if __name__ == '__main__':

@@ -1,7 +1,7 @@
 """The flow step's stages at one and two threads in a moving packing, and the exchange with YADE.
 
     PYTHONPATH=build/python /usr/bin/python3.11 bench/thread_stages.py [--n=10000,50000,200000]
-        [--solvers=cholesky,multigrid] [--rounds=7] [--exchange=1]
+        [--solvers=cholesky,multigrid] [--rounds=7] [--exchange=1] [--bandwidth_cores=8]
 
 The packing: pfv_testing.lattice.jittered_lattice(N) in the box of its extent plus 0.2, flow along y (100 against 0),
 every sphere drifting with its own constant random velocity of 2e-4 lattice spacings per step, no scheduled remesh.
@@ -19,6 +19,11 @@ velocity (no contacts), a pfv.FlowEngine, and the two halves of its exchange tim
 into O.forces), at ompThreads 1 and 2 alternately. Prints one table: per N, solver and stage the median time at one
 and two threads (ms), the per-round range, the speed-up of the medians (x) and of the best rounds (best: the
 rounds least disturbed by other processes on shared cores). No time is asserted.
+
+Then two models of the flow step (the core step plus the exchange) at 1, 2, 8, 16, 32 and 64 threads, each stage's
+one-thread median scaled by Amdahl's law, s + (1 - s) / p: with the serial fractions s fitted to the best rounds
+(t2 / t1 = s + (1 - s) / 2), and with those of the code (MODEL_STAGES). Stages that stream memory are held at no less
+than 1 / --bandwidth_cores (default 8) of their one-thread time. Beyond two threads both are extrapolations.
 """
 import json
 import os

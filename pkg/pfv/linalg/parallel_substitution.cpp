@@ -1,6 +1,7 @@
 #include "pfv/linalg/parallel_substitution.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <numeric>
 #include <type_traits>
@@ -169,6 +170,7 @@ inline int omp_team_size() {
 
 void ParallelSubstitution::plan(const SupernodalFactor& f, int threads) {
   L_ = f;
+  choice_.reset();  // another factor: other times
   const int ns = f.nsuper;
   std::vector<int> super_of(f.n);
   for (int s = 0; s < ns; ++s)
@@ -419,18 +421,26 @@ void ParallelSubstitution::backward_shared(const Stored* values, int s, int t, i
 }
 
 void ParallelSubstitution::solve(const double* b, double* x, bool parallel) {
+  // The schedules on offer: serial, the groups on the team, and the shared top as well.
+  const bool any_shared = std::find(shared_.begin(), shared_.end(), 1) != shared_.end();
+  const int available = parallel && groups_.size() > 1 ? (any_shared ? 3 : 2) : 1;
+  const Schedule schedule = available > 1 ? static_cast<Schedule>(choice_.pick(available)) : Schedule::kSerial;
+  const auto start = std::chrono::steady_clock::now();
   if (L_.scaled)
-    solve_with(L_.scaled, b, x, parallel);
+    solve_with(L_.scaled, b, x, schedule);
   else
-    solve_with(L_.values, b, x, parallel);
+    solve_with(L_.values, b, x, schedule);
+  if (available > 1)
+    choice_.record(available, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  last_schedule_ = schedule;
 }
 
 template <class Stored>
-void ParallelSubstitution::solve_with(const Stored* values, const double* b, double* x, bool parallel) {
+void ParallelSubstitution::solve_with(const Stored* values, const double* b, double* x, Schedule schedule) {
   const int n = L_.n;
   for (int k = 0; k < n; ++k) y_[k] = b[L_.perm[k]];
   const int groups = static_cast<int>(groups_.size());
-  parallel = parallel && groups > 1;
+  const bool parallel = schedule != Schedule::kSerial;
   const auto forward_group = [&](int g) {
     for (const auto& [a, z] : groups_[g])
       for (int s = a; s <= z; ++s) forward(values, s, g, false);
@@ -471,7 +481,7 @@ void ParallelSubstitution::solve_with(const Stored* values, const double* b, dou
       }
     }
   };
-  if (parallel && std::find(shared_.begin(), shared_.end(), 1) != shared_.end()) {
+  if (schedule == Schedule::kSharedTop) {
 #pragma omp parallel num_threads(groups)
     top(thread_index(), omp_team_size());
   } else {

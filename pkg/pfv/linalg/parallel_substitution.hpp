@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "pfv/linalg/schedule_choice.hpp"
+
 namespace pfv {
 
 // A read-only view of a supernodal LL' factor with CHOLMOD's pattern (cholmod_factor: super,
@@ -55,8 +57,17 @@ class ParallelSubstitution {
   static constexpr int kColumnBlock = 4;
   // x = (L L')^-1 applied to b in the original ordering. With parallel = false the groups
   // and the shared supernodes' pieces run one after the other on the calling thread (same
-  // arithmetic, the same result to the bit).
+  // arithmetic, the same result to the bit). With parallel = true it runs one of three
+  // schedules, all giving that result: serial; the groups on the team and the top on the
+  // calling thread (a fork and a join per sweep); or that and the shared supernodes on the
+  // team too (a barrier per block of kSharedBlock columns, about a hundred per solve at 10 000
+  // spheres). On free cores sharing pays; on cores other processes hold, each barrier waits up
+  // to a time slice for a descheduled thread, and the shared schedule is then the slowest by
+  // far. So the schedule is the fastest measured on this factor's solves
+  // (schedule_choice.hpp); the plan is the same whichever runs.
   void solve(const double* b, double* x, bool parallel = true);
+  enum class Schedule { kSerial, kGroups, kSharedTop };
+  Schedule last_schedule() const { return last_schedule_; }
 
  private:
   // Supernode s: its first column k1, its nscol columns and nsrow rows, the rows below its
@@ -90,7 +101,7 @@ class ParallelSubstitution {
   template <class Stored>
   void backward_shared(const Stored* values, int s, int t, int nt);
   template <class Stored>
-  void solve_with(const Stored* values, const double* b, double* x, bool parallel);
+  void solve_with(const Stored* values, const double* b, double* x, Schedule schedule);
 
   SupernodalFactor L_;
   std::vector<std::vector<std::pair<int, int>>> groups_;  // per thread: supernode ranges
@@ -104,6 +115,8 @@ class ParallelSubstitution {
   std::vector<double> y_;
   std::vector<double> inverse_;  // per column, in elimination order: 1 / L(j, j), set by plan()
   double top_fraction_ = 1;
+  ScheduleChoice<3> choice_;  // indexed by Schedule
+  Schedule last_schedule_ = Schedule::kSerial;
 };
 
 }  // namespace pfv

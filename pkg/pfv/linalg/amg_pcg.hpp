@@ -19,7 +19,7 @@
 // makes them swing past 1), and from the second iteration on one below 1e-3 of the bound stops
 // the solve whatever the ratios (at the rounding floor they are noise). The first iteration has
 // no ratio of its own: it takes twice that last measured ratio (as the refinement seeds its
-// contraction), and without one it does not stop, however small its update: a good start leaves
+// contraction), or halfway from it to 1 where that is less, and without one it does not stop, however small its update: a good start leaves
 // a small first update whatever error remains in the modes the V-cycle reduces slowly. The first
 // solve on a system goes on to 1e-8 of the spread at least (when the tolerance is looser), so that
 // the ratio the later solves rely on is measured over enough iterations; on a system without

@@ -275,7 +275,10 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
       // a start the history predicted well leaves a small update, which says nothing of the
       // error left in what the V-cycle reduces slowly.
       previous = d;
-      const double seed = kSeedSafety * seen_ratio_;
+      // Twice the measured ratio, or halfway from it to 1 where that is less (a ratio of 1/2 or
+      // more, as the Jacobi and split smoothers measure, would otherwise never let a first
+      // update certify a step, however small).
+      const double seed = std::min(kSeedSafety * seen_ratio_, 0.5 * (1 + seen_ratio_));
       return seed > 0 && seed < 1 && seed / (1 - seed) * d <= bound;
     }
     if (d <= kNegligibleUpdate * bound) return true;

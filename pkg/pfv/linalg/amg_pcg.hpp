@@ -19,15 +19,16 @@
 // makes them swing past 1), and from the second iteration on one below 1e-3 of the bound stops
 // the solve whatever the ratios (at the rounding floor they are noise). The first iteration has
 // no ratio of its own: it takes twice that last measured ratio (as the refinement seeds its
-// contraction), and without one it does not stop, however small its update: a good start leaves
-// a small first update whatever error remains in the modes the V-cycle reduces slowly. The first
-// solve on a system goes on to 1e-8 of the spread at least (when the tolerance is looser), so that
-// the ratio the later solves rely on is measured over enough iterations; on a system without
-// one, a solve does not stop on a single ratio either. At refinement_tolerance 1e-4 in a moving
-// packing, pressures came out 2.4 times the bound without these (multigrid_start_test.cpp).
+// contraction), or halfway from it to 1 where that is less, and without one it does not stop,
+// however small its update: a good start leaves a small first update whatever error remains in
+// the modes the V-cycle reduces slowly. The first solve on a system goes on to 1e-8 of the
+// spread at least (when the tolerance is looser), so that the ratio the later solves rely on is
+// measured over enough iterations; on a system without one, a solve does not stop on a single
+// ratio either. At refinement_tolerance 1e-4 in a moving packing, pressures came out 2.4 times the
+// bound without these (multigrid_start_test.cpp).
 //
 // The start (AmgParameters::start_history > 0, as the engine's solver sets it) is extrapolated
-// from the last solutions on this system, of the order whose residual is the smallest
+// in time from the last solutions on this system, of the order whose residual is the smallest
 // (solution_history.hpp): between remeshes, in a smooth motion, one iteration (one V-cycle, two
 // products with G) is then the common case.
 //

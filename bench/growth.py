@@ -32,10 +32,10 @@ against another's:
     step and factorises at the next: the window covers both).
   --threads: one timing child per N and thread count T (`yade-double -jT`, OMP_NUM_THREADS=T); the memory children
     run at one thread.
-  In a moving packing the spheres are held still during the dry blocks, and WARM = 3 untimed coupled steps precede
+  In a moving packing the spheres are held still during the dry blocks, and WARM = 8 untimed coupled steps precede
     each coupled block and the forced remesh: the engine finds the spheres where it left them, but O.iter has moved
-    on, so it forgets its dV/dt history (and multigrid its extrapolated start) as after any gap; the warm steps
-    rebuild both.
+    on, so it forgets its dV/dt history (and multigrid the solution history its start is extrapolated from) as after
+    any gap; the warm steps rebuild both (multigrid settles at its steady iteration count within about six steps).
   memory child, one per N and engine: peak RSS = VmHWM (reset through /proc/self/clear_refs once the scene is
     built) minus VmRSS before the engine is added, over a first step, 3 steps and a forced remesh.
 YADE runs at --sizes only; --pfv-sizes are PFV alone (YADE's factor at those sizes does not fit this machine), both
@@ -70,7 +70,7 @@ def markers(motion):
 
 WINDOW = 3
 BLOCK = 3  # steps per block of coupled or dry steps
-WARM = 3  # in a moving packing, untimed coupled steps before each block (after the gap of a dry block)
+WARM = 8  # in a moving packing, untimed coupled steps before each block (after the gap of a dry block)
 KINDS = ("yade", "pfv", "pfv-multigrid")
 
 

@@ -33,8 +33,9 @@ struct SolveTally {
   SolveHistory history(SolveHistory before, bool multigrid) const;
 };
 
-// CG iterations per step assumed where multigrid has not run: a smooth motion's (a fixed skeleton
-// takes one, a packing whose every sphere keeps its velocity two).
+// CG iterations per step assumed where multigrid has not run: between a smooth motion's (a fixed
+// skeleton or a steady drift takes one to one and a half) and those of velocities that change
+// from step to step (up to about eleven), on the side of the factor at the sizes where both fit.
 constexpr double kAssumedMultigridIterations = 2;
 
 // The inputs of a choice: the system's unknowns and the history of the last one.

@@ -1,7 +1,7 @@
 """Growth with N of both engines' costs: first step, remesh, flow step, dry DEM step, peak memory.
 
     yade-double -n -x bench/growth.py [--motion=static|drift|compression] [--sizes=1e4,5e4,2e5]
-                [--pfv-sizes=5e5,1e6:mg] [--threads=1[,2]] [--blocks=5] [--out=doc/scaling.md]
+                [--pfv-sizes=5e5,1e6:mg] [--threads=1[,2]] [--memory=no] [--blocks=5] [--out=doc/scaling.md]
                 [--figure=doc/figures/growth.png] [--json=FILE]
     yade-double -n -x bench/growth.py --quick        (3 000 and 6 000 spheres, PFV also alone at 12 000: CI)
     yade-double -n -x bench/growth.py --report-only [--json=FILE] [--out=...] [--figure=...]
@@ -31,7 +31,7 @@ against another's:
     W steps from the forced remesh minus (W - 1) coupled steps, minus one dry step (YADE remeshes at the end of a
     step and factorises at the next: the window covers both).
   --threads: one timing child per N and thread count T (`yade-double -jT`, OMP_NUM_THREADS=T); the memory children
-    run at one thread.
+    run at one thread (--memory=no: none).
   In a moving packing the spheres are held still during the dry blocks, and WARM = 8 untimed coupled steps precede
     each coupled block and the forced remesh: the engine finds the spheres where it left them, but O.iter has moved
     on, so it forgets its dV/dt history (and multigrid the solution history its start is extrapolated from) as after
@@ -81,6 +81,7 @@ def options(argv):
         blocks="5",
         motion="static",
         threads="1",
+        memory="yes",
         out="",
         figure="",
         json="/tmp/bench/growth.json",
@@ -486,7 +487,7 @@ def driver(o):
                 print(f"growth: N = {n}: timing {', '.join(kinds)} at {threads} thread(s)", flush=True)
                 args = ["--child=time", f"--n={n}", f"--kinds={','.join(kinds)}", f"--blocks={blocks}", motion]
                 data["timing"].append(run_child(args, threads))
-            for kind in kinds:
+            for kind in kinds if o["memory"] == "yes" else ():
                 print(f"growth: N = {n}: memory of {kind}", flush=True)
                 data["memory"].append(run_child(["--child=memory", f"--n={n}", f"--kinds={kind}", motion]))
             with open(o["json"], "w") as f:  # after every size: a long run keeps what it measured

@@ -34,10 +34,25 @@ double iteration_cost(const CostInputs& in) {
 
 }  // namespace
 
+void SolveTally::add(int cg_iterations) {
+  if (steps++ == 0) return;     // a cold start
+  constexpr int kCounted = 64;  // beyond, the factor wins at any size this counts for
+  const auto k = static_cast<std::size_t>(std::clamp(cg_iterations, 0, kCounted));
+  if (steps_with.size() <= k) steps_with.resize(k + 1, 0);
+  ++steps_with[k];
+}
+
 SolveHistory SolveTally::history(SolveHistory before, bool multigrid) const {
   if (steps == 0) return before;  // never solved: nothing learnt
   before.steps_per_system = steps;
-  if (multigrid && steps > 1) before.multigrid_iterations = static_cast<double>(iterations_after_first) / (steps - 1);
+  if (multigrid && steps > 1) {
+    long below = 0;
+    for (std::size_t k = 0; k < steps_with.size(); ++k)
+      if (2 * (below += steps_with[k]) >= steps - 1) {
+        before.multigrid_iterations = static_cast<double>(k);
+        break;
+      }
+  }
   return before;
 }
 

@@ -6,6 +6,8 @@
 // benchmark lattice at one thread (doc/solvers.md, "solver = auto"): the choice is the same on
 // every run of a scene, whatever the machine's load, and only the ratio of the weights matters.
 #pragma once
+#include <vector>
+
 #include "pfv/engine/engine_settings.hpp"
 
 namespace pfv {
@@ -22,14 +24,15 @@ struct SolveHistory {
 };
 
 // The counts of one linear system's solves: the steps it served and multigrid's iterations.
+// The steady count is the median over the steps after the first: the cold starts of a new system
+// are the cost model's own term, and those after a gap in the engine's history (a step it was
+// not run for) are no more typical of the steps to come.
 struct SolveTally {
   long steps = 0;
-  long iterations_after_first = 0;  // CG iterations of every step but the first (a cold start)
+  std::vector<long> steps_with;  // steps after the first by CG iterations (the last: that many or more)
 
-  void add(int cg_iterations) {
-    if (steps++ > 0) iterations_after_first += cg_iterations;
-  }
-  // The history it leaves: the steps, and the iterations per step if multigrid solved them.
+  void add(int cg_iterations);
+  // The history it leaves: the steps, and the median iterations per step if multigrid solved them.
   SolveHistory history(SolveHistory before, bool multigrid) const;
 };
 

@@ -15,35 +15,26 @@ import sys
 import numpy as np
 
 from pfv_testing.cli import option
-from pfv_testing.lattice import jittered_lattice
+from pfv_testing.lattice import jittered_lattice, permeameter_engine, walls_around
 
 STEPS = 100
 STATIC = 1e10
 
 
-def permeameter(pfv):
-    e = pfv.Engine()
-    e.bnd_is_pressure = [False, False, True, True, False, False]
-    e.bnd_value = [0, 0, 100.0, 0, 0, 0]
-    e.viscosity = 1e-3
-    e.mesh_update_interval = 10**9
-    return e
-
-
-def row(pfv, n, drift):
+def row(n, drift):
     pos, rad = jittered_lattice(n)
-    lo, hi = (pos - rad[:, None]).min(0) - 0.2, (pos + rad[:, None]).max(0) + 0.2
-    walls = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
+    walls = walls_around(pos, rad, 0.2)
+    lo, hi = np.array(walls[0::2]), np.array(walls[1::2])
     rng = np.random.default_rng(3)
     d = rng.normal(size=pos.shape)
     d *= (drift / STEPS) / np.linalg.norm(d, axis=1)[:, None]
     keep_in = (lo + rad[:, None] * 1.01, hi - rad[:, None] * 1.01)
-    stale = permeameter(pfv)
+    stale = permeameter_engine()
     for _ in range(STEPS):
         stale.step(pos, rad, walls, STATIC)
         pos = np.clip(pos + d, *keep_in)
     stale.step(pos, rad, walls, STATIC)
-    fresh = permeameter(pfv)
+    fresh = permeameter_engine()
     fresh.step(pos, rad, walls, STATIC)
     fa, fb = stale.forces()[:n], fresh.forces()[:n]
     return dict(
@@ -56,8 +47,6 @@ def row(pfv, n, drift):
 
 
 def main(argv):
-    import pfv
-
     sizes = [a for a in argv if not a.startswith('--')]
     n = int(float(sizes[0])) if sizes else 3000
     drifts = [float(x) for x in option(argv, 'drifts', '0.01,0.02,0.05,0.1,0.2').split(',')]
@@ -67,7 +56,7 @@ def main(argv):
     )
     print('|---|---|---|---|---|---|')
     for drift in drifts:
-        r = row(pfv, n, drift)
+        r = row(n, drift)
         print(
             f"| {drift:g} | {100 * r['cells']:.2g} % | {100 * r['volume']:.2g} % | {100 * r['flux']:.2g} % "
             f"| {100 * r['forces']:.2g} % | {r['forced']} |",

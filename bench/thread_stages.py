@@ -35,6 +35,7 @@ import time
 import numpy as np
 
 from pfv_testing.cli import option
+from pfv_testing.lattice import jittered_lattice, permeameter_engine, walls_around
 
 DRIFT = 2e-4  # lattice spacings per step
 STAGES = ('volumes', 'solve', 'forces', 'rest', 'core total', 'Engine.step')
@@ -47,27 +48,12 @@ def option_list(argv, name, default, kind=str):
 
 
 def drifting_packing(n):
-    from pfv_testing.lattice import jittered_lattice
-
     pos, rad = jittered_lattice(n)
-    lo, hi = (pos - rad[:, None]).min(0) - 0.2, (pos + rad[:, None]).max(0) + 0.2
-    walls = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
+    walls = walls_around(pos, rad, 0.2)
     rng = np.random.default_rng(3)
     velocity = rng.normal(size=pos.shape)
     velocity *= DRIFT / np.linalg.norm(velocity, axis=1)[:, None]
     return pos, rad, walls, velocity
-
-
-def make_engine(solver):
-    import pfv
-
-    e = pfv.Engine()
-    e.bnd_is_pressure = [False, False, True, True, False, False]
-    e.bnd_value = [0, 0, 100.0, 0, 0, 0]
-    e.viscosity = 1e-3
-    e.mesh_update_interval = 10**9
-    e.solver = solver
-    return e
 
 
 def timed_step(engine, threads, pos, rad, walls):
@@ -97,7 +83,7 @@ def largest_difference(a, b):
 def core_rows(n, solver, rounds, warmup=3):
     """Per stage: the times at 1 and at 2 threads, one per round; and the largest difference seen."""
     pos, rad, walls, velocity = drifting_packing(n)
-    engines = {1: make_engine(solver), 2: make_engine(solver)}
+    engines = {1: permeameter_engine(solver), 2: permeameter_engine(solver)}
     times = {t: {s: [] for s in STAGES} for t in engines}
     diff = 0.0
     for k in range(warmup + rounds):

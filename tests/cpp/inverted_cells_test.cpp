@@ -19,22 +19,6 @@ namespace {
 
 constexpr double kStatic = 1e10;  // a time step that makes dV/dt negligible: flow from the walls alone
 
-// side^3 spheres on a cubic lattice of spacing 1, centres jittered by up to 0.03 and radii 0.42
-// +- 10 % (the benchmarks' packing). Its near-cospherical cells flip under small motion.
-TestPacking jittered_lattice(int side, unsigned seed) {
-  TestPacking p;
-  std::mt19937 gen(seed);
-  std::uniform_real_distribution<double> u(-1, 1);
-  for (int i = 0; i < side; ++i)
-    for (int j = 0; j < side; ++j)
-      for (int k = 0; k < side; ++k) {
-        p.centre.emplace_back(i + 0.5 + 0.03 * u(gen), j + 0.5 + 0.03 * u(gen), k + 0.5 + 0.03 * u(gen));
-        p.radius.push_back(0.42 * (1 + 0.1 * u(gen)));
-      }
-  p.walls.coord = {-0.2, side + 0.2, -0.2, side + 0.2, -0.2, side + 0.2};
-  return p;
-}
-
 // One random unit direction per sphere.
 std::vector<Vec3> directions(std::size_t n, unsigned seed) {
   std::mt19937 gen(seed);
@@ -102,7 +86,7 @@ TEST(InvertedCells, TheStepRunsOnAndConservesMass) {
   // cells are inside out. The step runs on with the old mesh, and its volume rates sum to the rate
   // of change of the box's volume, as the cells' signed volumes still tile the box. With
   // |volume| instead, an inverted cell's rate had the wrong sign: a spurious source.
-  const TestPacking p = jittered_lattice(10, 3);
+  const TestPacking p = test::benchmark_lattice(10, 3);
   const std::vector<Vec3> dir = directions(p.centre.size(), 4);
   FlowEngine e = never_remeshing(permeameter(1));
   const double dt = 1e-3, wall_speed = 0.05;
@@ -133,7 +117,7 @@ TEST(InvertedCells, TheErrorAgainstAFreshMeshFollowsTheMotion) {
   // error against a mesh built at the current positions grows with the motion since the remesh,
   // about linearly in the forces (measured: 1.5-1.8 x the drift in spacings), and the inverted
   // cells add no jump to it. Bound: twice the drift, for the forces and the flux.
-  const TestPacking p = jittered_lattice(10, 5);
+  const TestPacking p = test::benchmark_lattice(10, 5);
   const std::vector<Vec3> dir = directions(p.centre.size(), 6);
   for (double drift : {0.01, 0.02, 0.05}) {
     FlowEngine stale = never_remeshing(permeameter(1, 100.0));
@@ -156,7 +140,7 @@ TEST(InvertedCells, MotionPastAnyScheduleRemeshesAtOnce) {
   // The spheres random-walk about half a spacing since the remesh (four jumps of a quarter
   // spacing): more than 2 % of the volume is inside out, the old mesh describes the pore space in
   // name only. The step remeshes at these positions and gives what a fresh engine gives.
-  const TestPacking p = jittered_lattice(10, 7);
+  const TestPacking p = test::benchmark_lattice(10, 7);
   FlowEngine e = never_remeshing(permeameter(1, 100.0));
   e.step(p.centre, p.radius, p.walls, kStatic);
   const std::vector<Vec3> x = jumped(p, 0.25, 4, 8);

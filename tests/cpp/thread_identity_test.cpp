@@ -23,21 +23,6 @@ using test::TestPacking;
 
 namespace {
 
-// side^3 spheres on a unit cubic lattice, centres jittered by up to 0.03, radii 0.42 +- 10 %.
-TestPacking lattice(int side, unsigned seed) {
-  TestPacking p;
-  std::mt19937 gen(seed);
-  std::uniform_real_distribution<double> u(-1, 1);
-  for (int i = 0; i < side; ++i)
-    for (int j = 0; j < side; ++j)
-      for (int k = 0; k < side; ++k) {
-        p.centre.emplace_back(i + 0.5 + 0.03 * u(gen), j + 0.5 + 0.03 * u(gen), k + 0.5 + 0.03 * u(gen));
-        p.radius.push_back(0.42 * (1 + 0.1 * u(gen)));
-      }
-  p.walls.coord = {-0.2, side + 0.2, -0.2, side + 0.2, -0.2, side + 0.2};
-  return p;
-}
-
 // Every sphere's own constant velocity: 'speed' along a random direction.
 std::vector<Vec3> velocities(std::size_t n, double speed, unsigned seed) {
   std::mt19937 gen(seed);
@@ -82,7 +67,7 @@ void expect_same_steps(SolverKind solver) {
 #ifndef _OPENMP
   GTEST_SKIP() << "built without OpenMP";
 #endif
-  const TestPacking p = lattice(16, 5);
+  const TestPacking p = test::benchmark_lattice(16, 5);
   const std::vector<Vec3> v = velocities(p.centre.size(), 0.02, 6);
   FlowEngine one = drifting_engine(solver), two = drifting_engine(solver);
   std::vector<Vec3> x = p.centre;

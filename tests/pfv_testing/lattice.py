@@ -18,19 +18,28 @@ def jittered_lattice(n: int, seed: int = 1) -> tuple[np.ndarray, np.ndarray]:
     return centres, radii
 
 
-def lattice_permeameter(n):
-    """The C++ engine (pfv.Engine, not yet stepped), centres, radii and walls of the benchmarks' lattice permeameter:
-    jittered_lattice(n), flow along y (p = 100 on ymin, 0 on ymax), viscosity 1e-3, the walls at the spheres' extent,
-    no automatic remesh, the multigrid solver."""
+def walls_around(pos, rad, margin=0.0):
+    """The six wall coordinates (xmin, xmax, ymin, ...) `margin` beyond the spheres' extent."""
+    lo, hi = (pos - rad[:, None]).min(0) - margin, (pos + rad[:, None]).max(0) + margin
+    return [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
+
+
+def permeameter_engine(solver='auto'):
+    """The C++ engine (pfv.Engine, not yet stepped) of the benchmarks' permeameter: flow along y (p = 100 on ymin, 0
+    on ymax), viscosity 1e-3, no automatic remesh, `solver`."""
     import pfv
 
-    pos, rad = jittered_lattice(n)
-    lo, hi = (pos - rad[:, None]).min(0), (pos + rad[:, None]).max(0)
-    walls = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
     e = pfv.Engine()
     e.bnd_is_pressure = [False, False, True, True, False, False]
     e.bnd_value = [0, 0, 100.0, 0, 0, 0]
     e.viscosity = 1e-3
     e.mesh_update_interval = 10**9
-    e.solver = 'multigrid'
-    return e, pos, rad, walls
+    e.solver = solver
+    return e
+
+
+def lattice_permeameter(n):
+    """The engine (permeameter_engine, multigrid), centres, radii and walls of the benchmarks' lattice permeameter:
+    jittered_lattice(n), the walls at the spheres' extent."""
+    pos, rad = jittered_lattice(n)
+    return permeameter_engine('multigrid'), pos, rad, walls_around(pos, rad)

@@ -76,7 +76,7 @@ double refinement_contraction(const FlowEngine& e) {
   return c ? c->refinement_contraction() : -1.0;
 }
 
-const std::string& solver_choice(const FlowEngine& e) { return e.linear_system().choice; }
+const std::string& solver_choice(const FlowEngine& e) { return e.linear_system().decision.choice; }
 
 const StageTimes& system_times(const FlowEngine& e) { return e.linear_system().times; }
 

@@ -157,12 +157,8 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
           return geometric_ordering(*s.matrix, point);
         };
     }
-    SolverDecision decision;
-    l.solver = set_up_solver(std::move(plan), s.matrix, options, settings, t0, decision);
-    l.choice = std::move(decision.choice);
-    l.times.analysis = decision.analysis;
-    l.factor_values = decision.factor_values;
-    l.multigrid_by_cost = decision.by_cost;
+    l.solver = set_up_solver(std::move(plan), s.matrix, options, settings, t0, l.decision);
+    l.times.analysis = l.decision.analysis;
     if (const CholeskySolver* cholesky = l.cholesky()) {
       const CholmodSolver& f = cholesky->factor();
       if (f.ready() && f.permutation())
@@ -175,7 +171,7 @@ LinearSystem build_linear_system(const PoreMesh& m, const BoundaryConditions& bc
     l.solver = std::move(plan.solver);
   }
   l.times.factorization = seconds_since(t0) - l.times.analysis;
-  if (l.choice.empty()) l.choice = std::string(to_string(l.solver->kind())) + ": as set";
+  if (l.decision.choice.empty()) l.decision.choice = std::string(to_string(l.solver->kind())) + ": as set";
   return l;
 }
 
@@ -183,8 +179,8 @@ SolveHistory history_after(const LinearSystem& system, SolveHistory before) {
   const bool multigrid = system.solver && system.solver->kind() == SolverKind::kMultigrid;
   SolveHistory h = system.tally.history(before, multigrid);
   if (system.recipe.solver == SolverKind::kAuto && system.solver) {
-    h.factor_values = system.factor_values;
-    h.multigrid_by_cost = system.multigrid_by_cost;
+    h.factor_values = system.decision.factor_values;
+    h.multigrid_by_cost = system.decision.by_cost;
   }
   return h;
 }

@@ -12,6 +12,7 @@
 #include "pfv/engine/engine_settings.hpp"
 #include "pfv/engine/pore_mesh.hpp"
 #include "pfv/engine/solver_cost.hpp"
+#include "pfv/engine/solver_policy.hpp"
 #include "pfv/engine/stage_times.hpp"
 #include "pfv/linalg/ordering_reuse.hpp"
 #include "pfv/linalg/pressure_solver.hpp"
@@ -60,12 +61,9 @@ struct LinearSystem {
   std::vector<std::pair<int, double>> profile_pressure;
   FieldCells field;  // of the PressureField's wall, gathered at the first step that needs them
   SystemRecipe recipe;
-  // The solver built and why ("multigrid: the Cholesky factor would store ..."), for reports.
-  std::string choice;
-  // Under kAuto: the factor values CHOLMOD's analysis projected (0: none), and whether the cost
-  // model rather than the memory refused them (solver_policy.hpp).
-  double factor_values = 0;
-  bool multigrid_by_cost = false;
+  // The solver built and why ("multigrid: the Cholesky factor would store ..."), for reports and
+  // for the next system's choice under kAuto (solver_policy.hpp).
+  SolverDecision decision;
   SolveTally tally;  // the steps this system served, multigrid's iterations
   StageTimes times;  // assembly, analysis, factorization
 

@@ -200,10 +200,10 @@ bool auto_keeps_multigrid(const EngineSettings& settings, const LinearSystem& cu
   if (settings.solver != SolverKind::kAuto || !current.solver || current.solver->kind() != SolverKind::kMultigrid ||
       current.recipe.max_factor_bytes != settings.max_factor_bytes)
     return false;
-  if (!current.multigrid_by_cost) return true;  // the memory refused the factor: it still would
+  if (!current.decision.by_cost) return true;  // the memory refused the factor: it still would
   // The factor projected then, weighed again with what the last system's solves showed.
   const CostInputs cost = cost_inputs(current.system.n_unknowns(), history, settings);
-  return current.factor_values > break_even_factor_values(cost);
+  return current.decision.factor_values > break_even_factor_values(cost);
 }
 
 std::unique_ptr<PressureSolver> release_solver(const EngineSettings& settings, LinearSystem& current,

@@ -32,6 +32,8 @@ constexpr double kInvertedVolumeForRemesh = 0.02;
 }  // namespace
 
 void FlowEngine::release() {
+  refuse_inside_hook("release");
+  undo_.reset();
   remesher_.reset();
   mesh_.reset();
   linear_ = LinearSystem{};
@@ -62,7 +64,7 @@ FlowEngine::RunState FlowEngine::run_state() const {
 }
 
 void FlowEngine::resume(const RunState& s, double dt) {
-  release();
+  release();  // (refuses to run inside the mesh hook)
   validate(settings);
   validate(bc);
   validate_snapshot(s.mesh.centres, s.mesh.radii, s.mesh.walls);
@@ -105,25 +107,32 @@ const CholmodSolver& FlowEngine::cholmod() const {
 
 void FlowEngine::step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                       double dt) {
+  refuse_inside_hook("step");
   const auto start = StageClock::now();
-  validate_step(centres, radii, walls, dt);
-  schedule_remesh(centres, radii, walls, dt);
-  rebuild_stale_system(dt);
-  // From here on everything writes into scratch buffers; the engine's state changes only in
-  // commit(), once the step has produced finite pressures and forces.
-  double strain = assemble(centres, walls, dt);
-  if (inverted_volume_ > kInvertedVolumeForRemesh * meshed_volume_) {
-    // Spheres moved so far since the remesh that 2 % of the volume turned inside out: the
-    // throats no longer describe the pore space. Remesh at these positions, whatever the
-    // schedule says. (Less runs on with signed volumes: see cell_volume.)
-    remesh_now(centres, radii, walls, dt);
-    ++inversion_remeshes_;
-    strain = assemble(centres, walls, dt);
+  begin_undo();
+  try {
+    validate_step(centres, radii, walls, dt);
+    schedule_remesh(centres, radii, walls, dt);
+    rebuild_stale_system(dt);
+    // From here on everything writes into scratch buffers; the results change only in commit(),
+    // once the step has produced finite pressures and forces.
+    double strain = assemble(centres, walls, dt);
+    if (inverted_volume_ > kInvertedVolumeForRemesh * meshed_volume_) {
+      // Spheres moved so far since the remesh that 2 % of the volume turned inside out: the
+      // throats no longer describe the pore space. Remesh at these positions, whatever the
+      // schedule says. (Less runs on with signed volumes: see cell_volume.)
+      remesh_now(centres, radii, walls, dt);
+      ++inversion_remeshes_;
+      strain = assemble(centres, walls, dt);
+    }
+    assemble_rhs();
+    solve(dt);
+    compute_forces(centres, radii, dt);
+    commit(centres, walls, strain);
+  } catch (...) {
+    retract_step();
+    throw;
   }
-  assemble_rhs();
-  solve(dt);
-  compute_forces(centres, radii, dt);
-  commit(centres, walls, strain);
   step_times_.total = seconds_since(start);
 }
 
@@ -158,8 +167,10 @@ void FlowEngine::rebuild_stale_system(double dt) {
   if (mesh_->viscosity() != settings.conductance.viscosity) mesh_->set_viscosity(settings.conductance.viscosity);
   if (linear_.ready() && !system_rebuild_requested_ && !linear_.recipe.stale_for(settings, bc, dt)) return;
   const auto ordering = linear_.ordering;
-  linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver(),
-                                {&cells_, &measured_void_volume_}, solve_history_);
+  LinearSystem next = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), released_solver(),
+                                          {&cells_, &measured_void_volume_}, solve_history_);
+  retire_system();
+  linear_ = std::move(next);
   ++system_builds_;
   system_rebuild_requested_ = false;
 }
@@ -177,7 +188,7 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   int inverted_cells = 0;
   double inverted_volume = 0, meshed_volume = 0;
   next_volume_.resize(nc);
-  volume_rate_.resize(nc);
+  next_volume_rate_.resize(nc);
 #pragma omp parallel for schedule(static) reduction(max : max_change) \
     reduction(+ : inverted_cells, inverted_volume, meshed_volume) if (nc > kMinParallelLoop)
   for (int c = 0; c < nc; ++c) {
@@ -188,7 +199,7 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
     inverted_volume += inverted ? -v : 0.0;
     meshed_volume += std::abs(v);
     const double dv = has_prev_ ? v - volume_[c] : 0.0;
-    volume_rate_[c] = dv / dt;
+    next_volume_rate_[c] = dv / dt;
     max_change = std::max(max_change, std::abs(dv) / std::max(v, mesh_->mean_cell_volume));
     next_volume_[c] = v;
   }
@@ -197,7 +208,7 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   meshed_volume_ = meshed_volume;
   if (settings.volume_correction != 1)
     for (int c = 0; c < nc; ++c)
-      if (mesh_->cells.shape[c].n_walls == 0) volume_rate_[c] *= settings.volume_correction;
+      if (mesh_->cells.shape[c].n_walls == 0) next_volume_rate_[c] *= settings.volume_correction;
   step_times_.volumes = seconds_since(t0);
   return max_change;
 }
@@ -217,8 +228,8 @@ void FlowEngine::assemble_rhs() {
       step_times_.pressure_field = seconds_since(t0);
     }
   }
-  const RhsTerms terms{volume_rate_,    linear_.storage,  pressure_, linear_.imposed_flux_cells,
-                       bc.imposed_flux, linear_.couplings};
+  const RhsTerms terms{next_volume_rate_,          linear_.storage, pressure_,
+                       linear_.imposed_flux_cells, bc.imposed_flux, linear_.couplings};
   pfv::assemble_rhs(system, terms, next_pressure_, rhs_);
 }
 
@@ -242,7 +253,7 @@ void FlowEngine::solve(double dt) {
     SolveControl control = settings.solve_control();
     control.time_step = dt;  // multigrid's start: extrapolated in time
     last_solve_ = solver.solve(rhs_, solution_, control);
-    linear_.tally.add(last_solve_.cg_iterations);
+    linear_.tally.add(last_solve_.cg_iterations);     // undone with the step (begin_undo keeps a copy)
     keep_trend_ = solver.wants_extrapolated_start();  // false once promoted to a double factor
     for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
   }
@@ -286,20 +297,26 @@ void FlowEngine::commit(const std::vector<Vec3>& centres, const BoxWalls& walls,
   for (std::size_t v = 0; v < next_force_.size(); ++v)
     if (!next_force_[v].allFinite()) throw std::domain_error("non-finite fluid force on vertex " + std::to_string(v));
 
+  // From here on nothing throws. Each replaced buffer stays where retract_step() finds it.
+  undo_.committed = true;
   std::swap(volume_, next_volume_);
+  std::swap(volume_rate_, next_volume_rate_);
   // The pressures before this step start the next one's extrapolation only if they were
   // solved (or carried over) on this mesh: from pZero, 2 p - p0 would double the first solution
   // and start the second step as far off as the first.
-  if (keep_trend_ && pressures_solved_)
+  undo_.trend_kept = keep_trend_ && pressures_solved_;
+  if (undo_.trend_kept)
     std::swap(pressure_before_, pressure_);  // kept for the next start; its buffer becomes scratch
-  else if (!pressure_before_.empty())
-    std::vector<double>().swap(pressure_before_);
+  else
+    std::swap(pressure_before_, undo_.committed_pressure_before);  // none (freed when the step is accepted)
   std::swap(pressure_, next_pressure_);
   pressures_solved_ = true;
   std::swap(force_, next_force_);
   std::swap(shear_force_, next_shear_);
   remesher_.count_step(strain);
-  centres_prev_ = centres;
+  std::swap(centres_prev_, undo_.centres);
+  centres_prev_.assign(centres.begin(), centres.end());
+  undo_.walls = walls_prev_;
   walls_prev_ = walls;
   has_prev_ = true;
 }

@@ -5,6 +5,7 @@
 // viscous_stability.hpp (the stability limit); the right-hand-side physics is model/'s
 // (pressure_rhs.hpp), the remesh schedule and background remesh remesher.hpp's.
 #pragma once
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -25,6 +26,13 @@ class FlowEngine {
   BoundaryConditions bc;
   // Evaluated once per step (boundary_conditions.hpp); its values enter the right-hand side only.
   PressureField pressure_field;
+  // Called once for every new mesh, whichever way it came (remesh(), a step's own remesh, one
+  // adopted from the background, one forced by inverted cells), once the mesh is adopted and before
+  // its linear system is built: the place for conditions on the new cells (YADE's blockHook), so
+  // that they hold on every mesh from its first step. It may read the engine and set conditions on
+  // single cells; step(), remesh(), resume() and release() refuse to run inside it. A hook that
+  // throws fails the step.
+  std::function<void()> mesh_hook;
 
   FlowEngine() = default;
   FlowEngine(FlowEngine&&) = default;
@@ -32,8 +40,20 @@ class FlowEngine {
 
   // One coupled step at positions X(t); dt is the DEM step that led here.
   // Throws std::invalid_argument on bad positions or settings, std::domain_error on a singular
-  // system or non-finite results; the engine is unchanged by a step that throws.
+  // system or non-finite results; the engine is unchanged by a step that throws (its mesh, system,
+  // results, history, schedule and counts: see retract_step), but for a Cholesky factor that a
+  // failed remesh had released (the next step factorises again) and a background remesh in flight.
   void step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls, double dt);
+  // Undoes the last step (or remesh()) as if it had thrown: for a caller whose own part of the step
+  // failed after the engine's (the forces never reached the bodies). Possible until accept_step()
+  // or the next step or remesh(); edits of single cells made since are undone with it. Returns
+  // whether there was a step to undo.
+  bool retract_step();
+  // The last step stands: what retract_step() would need (the mesh a remesh replaced) is freed.
+  void accept_step();
+  // Grows with every mesh adopted and never repeats (a retracted remesh does not give its number
+  // back): the key of what callers keep per mesh.
+  long mesh_id() const { return mesh_id_; }
 
   // Remeshes now at these positions (in the foreground) without building the linear system:
   // the next step builds it, with the conditions set on the new cells meanwhile (YADE's blockHook
@@ -149,6 +169,49 @@ class FlowEngine {
   const StageTimes& step_times() const { return step_times_; }
 
  private:
+  // What a step may replace before it commits, and what its commit replaced (retract_step). The
+  // large objects are moved here, not copied, only when the step replaces them.
+  struct Undo {
+    bool open = false;        // a step (or remesh()) began and was neither accepted nor undone
+    bool committed = false;   // its commit() ran
+    bool trend_kept = false;  // commit() kept the pressures before it for the extrapolated start
+    // The state of the mesh the step replaced (adopt), when it did.
+    bool mesh_replaced = false;
+    std::unique_ptr<PoreMesh> mesh;
+    CellConditions cells;
+    std::vector<double> pressure, pressure_before, volume, volume_rate, measured_void_volume;
+    // The linear system the step replaced (adopt, rebuild_stale_system), when it did.
+    bool system_replaced = false;
+    LinearSystem linear;
+    // Taken at the start: the counts, flags and schedule.
+    SolveTally tally;
+    SolveHistory history;
+    SolveStats last_solve;
+    Remesher::Schedule schedule;
+    long launches = 0;                // the remesher's background remeshes
+    bool adopted_background = false;  // the step adopted a mesh built in the background
+    bool has_prev = false, pressures_solved = false, keep_trend = false, rebuild_requested = false;
+    int remesh_count = 0, inversion_remeshes = 0, system_builds = 0, field_evaluations = 0, inverted_cells = 0;
+    double inverted_volume = 0, meshed_volume = 0;
+    // What commit() replaced: the pressures before the extrapolation's (when not kept), the positions and walls.
+    std::vector<double> committed_pressure_before;
+    std::vector<Vec3> centres;  // keeps its capacity from step to step (reset())
+    BoxWalls walls;
+
+    // Frees what it holds, keeping the capacity of the positions' buffer.
+    void reset();
+  };
+  // flow_engine_undo.cpp: the start of a step or remesh(); moving the replaced mesh or system aside.
+  void begin_undo();
+  void retire_mesh();
+  void retire_system();
+  // Refuses step(), remesh(), resume() and release() inside mesh_hook.
+  void refuse_inside_hook(const char* what) const;
+  // Adopts the mesh, runs mesh_hook, and builds the mesh's system after it (with_system: the
+  // system is built now, recycling the given solver; else at the next step).
+  void adopt_and_hook(Remesh&& r, std::unique_ptr<PressureSolver> recycled, double dt, bool with_system);
+  void run_mesh_hook();
+
   // The stages of step(), in order.
   void validate_step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls,
                      double dt) const;
@@ -191,11 +254,11 @@ class FlowEngine {
 
   std::vector<double> pressure_, volume_, volume_rate_, rhs_, solution_;
   std::vector<Vec3> force_;
-  std::vector<double> next_volume_, next_pressure_;  // scratch of the step being computed
-  std::vector<double> field_values_;                 // scratch of the pressure field
-  std::vector<double> pressure_before_;              // the step before pressure_'s, on this mesh (extrapolated start)
-  bool keep_trend_ = false;                          // the solver of this step wants the extrapolated start next
-  bool pressures_solved_ = false;                    // pressure_ solved on this mesh (or carried over), not pZero
+  std::vector<double> next_volume_, next_pressure_, next_volume_rate_;  // scratch of the step being computed
+  std::vector<double> field_values_;                                    // scratch of the pressure field
+  std::vector<double> pressure_before_;  // the step before pressure_'s, on this mesh (extrapolated start)
+  bool keep_trend_ = false;              // the solver of this step wants the extrapolated start next
+  bool pressures_solved_ = false;        // pressure_ solved on this mesh (or carried over), not pZero
   std::vector<Vec3> next_force_;
   std::vector<Vec3> shear_force_, next_shear_;  // only with viscous_shear
   std::vector<Vec3> centres_prev_;
@@ -212,6 +275,9 @@ class FlowEngine {
   std::vector<double> measured_void_volume_;  // of the current mesh, by initialize_volumes (else empty)
   bool system_rebuild_requested_ = false;
   StageTimes remesh_times_, step_times_;
+  long mesh_id_ = 0;
+  bool in_hook_ = false;  // mesh_hook is running
+  Undo undo_;
 };
 
 }  // namespace pfv

@@ -19,7 +19,9 @@ void FlowEngine::adopt_finished_remesh() {
   // The worker could not see the old mesh: blocked cells carried over now need a new system.
   const bool carried = carry_blocked_cells(r->mesh, r->cells, centres_prev_, walls_prev_);
   adopt(std::move(r->mesh), std::move(r->linear), std::move(r->cells));
+  undo_.adopted_background = undo_.open;
   if (carried) system_rebuild_requested_ = true;
+  run_mesh_hook();  // conditions it sets on the new cells rebuild the system (block_cell and the like)
 }
 
 Remesh FlowEngine::mesh_without_system(const std::vector<Vec3>& centres, const std::vector<double>& radii,
@@ -35,25 +37,57 @@ void FlowEngine::remesh_now(const std::vector<Vec3>& centres, const std::vector<
                             double dt) {
   Remesh r = mesh_without_system(centres, radii, walls);
   // Free the old factor first (the largest object: peak memory is then one factor, not two).
-  // Should the new system fail, the old mesh is kept without a solver and the next step starts
-  // the remesh over; the last results stay readable meanwhile.
+  // Should the new system fail, the step is undone without the old factor, and the next step
+  // starts the remesh over.
   remesher_.request();
-  const auto ordering = linear_.ordering;  // survives the release of the old factor
-  r.linear =
-      build_linear_system(r.mesh, bc, settings, dt, ordering.get(), released_solver(), {&r.cells}, solve_history_);
-  adopt(std::move(r.mesh), std::move(r.linear), std::move(r.cells));
+  adopt_and_hook(std::move(r), released_solver(), dt, true);
   remesher_.restart();  // the schedule starts again
 }
 
+void FlowEngine::run_mesh_hook() {
+  if (!mesh_hook) return;
+  in_hook_ = true;
+  try {
+    mesh_hook();
+  } catch (...) {
+    in_hook_ = false;
+    throw;
+  }
+  in_hook_ = false;
+}
+
 void FlowEngine::remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const BoxWalls& walls) {
-  validate(settings);
-  validate(bc);
-  validate_snapshot(centres, radii, walls);
-  Remesh r = mesh_without_system(centres, radii, walls);
-  // No system yet: the next step builds it, with the conditions set on the new cells meanwhile.
-  r.linear.ordering = linear_.ordering;
-  adopt(std::move(r.mesh), std::move(r.linear), std::move(r.cells), false);
+  refuse_inside_hook("remesh");
+  begin_undo();
+  try {
+    validate(settings);
+    validate(bc);
+    validate_snapshot(centres, radii, walls);
+    // No system yet: the next step builds it, with the conditions set on the new cells meanwhile.
+    adopt_and_hook(mesh_without_system(centres, radii, walls), nullptr, 0, false);
+  } catch (...) {
+    retract_step();
+    throw;
+  }
   remesher_.restart();  // the schedule starts again
+}
+
+void FlowEngine::adopt_and_hook(Remesh&& r, std::unique_ptr<PressureSolver> recycled, double dt, bool with_system) {
+  const auto ordering = linear_.ordering;  // survives the release of the old factor
+  if (!mesh_hook && with_system) {         // the system first: the old mesh interpolates into the new one
+    r.linear =
+        build_linear_system(r.mesh, bc, settings, dt, ordering.get(), std::move(recycled), {&r.cells}, solve_history_);
+    adopt(std::move(r.mesh), std::move(r.linear), std::move(r.cells));
+    return;
+  }
+  r.linear.ordering = ordering;
+  adopt(std::move(r.mesh), std::move(r.linear), std::move(r.cells), false);
+  run_mesh_hook();
+  if (!with_system) return;
+  linear_ = build_linear_system(*mesh_, bc, settings, dt, ordering.get(), std::move(recycled),
+                                {&cells_, &measured_void_volume_}, solve_history_);
+  ++system_builds_;
+  system_rebuild_requested_ = false;
 }
 
 bool FlowEngine::carry_blocked_cells(const PoreMesh& m, CellConditions& conditions, const std::vector<Vec3>& centres,
@@ -114,8 +148,10 @@ void FlowEngine::adopt(PoreMesh&& mesh, LinearSystem&& linear, CellConditions&& 
   t.factorization = linear.times.factorization;
   t.carry_over = carry_seconds;
   remesh_times_ = t;
-  mesh_ = std::make_unique<PoreMesh>(std::move(mesh));
   solve_history_ = history_after(linear_, solve_history_);
+  retire_mesh();  // aside while a step that may be undone runs, else freed here
+  mesh_ = std::make_unique<PoreMesh>(std::move(mesh));
+  ++mesh_id_;
   linear_ = std::move(linear);
   pressure_ = std::move(pressure);
   pressures_solved_ = interpolated;  // else pZero: no history to extrapolate from

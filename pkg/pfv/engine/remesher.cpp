@@ -37,6 +37,7 @@ void Remesher::remesh_in_background(const std::vector<Vec3>& centres, const std:
                                     const BoxWalls& walls, const EngineSettings& settings, const BoundaryConditions& bc,
                                     double dt, std::shared_ptr<const CellOrdering> ordering, bool keep_multigrid,
                                     const SolveHistory& history) {
+  ++launches_;
   // Snapshot now, build on another thread, carry on with the current mesh meanwhile. The current
   // solver stays in use; an empty multigrid solver stands for it where kAuto keeps that choice
   // (without it the worker would pay the ordering and analysis that decided it again).

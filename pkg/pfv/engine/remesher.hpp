@@ -42,6 +42,8 @@ class Remesher {
   bool requested() const { return requested_; }
   // A mesh (and its system) is being built in the background.
   bool pending() const { return pending_.has_value(); }
+  // Background remeshes started so far.
+  long launches() const { return launches_; }
   // Blocks until a background remesh in flight has finished; the next step adopts it.
   void wait() const;
   // A background remesh in flight is superseded: waited for and dropped.
@@ -69,6 +71,18 @@ class Remesher {
   double strain() const { return strain_; }
   // The schedule of a saved run (FlowEngine::resume).
   void restore(int steps_since_remesh, double strain);
+  // The whole schedule, for a step that may be undone (FlowEngine::retract_step).
+  struct Schedule {
+    double strain = 0;
+    int steps_since_remesh = 0;
+    bool requested = false;
+  };
+  Schedule schedule() const { return {strain_, steps_since_remesh_, requested_}; }
+  void set_schedule(const Schedule& s) {
+    strain_ = s.strain;
+    steps_since_remesh_ = s.steps_since_remesh;
+    requested_ = s.requested;
+  }
   // Drops any remesh in flight and asks for a new mesh (FlowEngine::release).
   void reset();
 
@@ -77,6 +91,7 @@ class Remesher {
     std::future<Remesh> result;
   };
   std::optional<Pending> pending_;
+  long launches_ = 0;
   double strain_ = 0;
   int steps_since_remesh_ = 0;
   bool requested_ = true;

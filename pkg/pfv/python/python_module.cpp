@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
@@ -335,6 +336,39 @@ PYBIND11_MODULE(_core, m) {
           py::arg("wall"), py::arg("field"),
           "field(positions (n, 3)) -> n pressures of the Dirichlet cells of `wall`, called once per step (the\n"
           "right-hand side only: no new system); None or wall -1: none. It must not call the engine.")
+      .def(
+          "set_mesh_hook",
+          [](SharedEngine& e, py::object fn) {
+            std::function<void()> hook;
+            if (!fn.is_none()) {
+              if (!PyCallable_Check(fn.ptr())) throw py::type_error("the mesh hook must be callable or None");
+              // Runs inside step(), which holds the engine's lock and released the GIL: the hook's
+              // calls into the engine pass the lock (EngineLock), the GIL is taken back for the call.
+              hook = [&e, fn = std::move(fn)]() {
+                py::gil_scoped_acquire gil;
+                e.hook_running.store(true);
+                try {
+                  fn();
+                } catch (...) {
+                  e.hook_running.store(false);
+                  throw;
+                }
+                e.hook_running.store(false);
+              };
+            }
+            // The old hook (maybe a Python callable) is dropped here, with the GIL held.
+            const EngineLock lock(e);
+            std::swap(e.mesh_hook, hook);
+          },
+          py::arg("hook"),
+          "hook() called for every new mesh before its linear system is built (YADE's blockHook), in the\n"
+          "step: it may read the engine and set conditions on cells; None: none.")
+      .def("retract_step", exclusive(&FlowEngine::retract_step),
+           "Undo the last step (or remesh) as if it had failed; False if there is none to undo.")
+      .def("accept_step", exclusive(&FlowEngine::accept_step),
+           "The last step stands: free what retract_step would need.")
+      .def_property_readonly("mesh_id", exclusive(&FlowEngine::mesh_id),
+                             "Grows with every mesh adopted, never repeats (a retracted remesh keeps its number).")
       .def_property_readonly("pressure_field_wall",
                              exclusive([](const SharedEngine& e) { return e.pressure_field.wall; }))
       .def_property_readonly("field_evaluations", exclusive(&FlowEngine::field_evaluations),

@@ -58,26 +58,33 @@ inline BoxWalls to_walls(const std::array<double, 6>& w) {
 // lock; a caller that must wait does so with the GIL released (a step releases the GIL while it
 // runs, and never needs it while it holds the lock), so the two threads cannot deadlock.
 // A call from the thread that holds the lock (a boundary-pressure function calling the engine
-// during the step that calls it) would wait for itself forever: it raises instead.
+// during the step that calls it) would wait for itself forever: it raises instead, except from the
+// mesh hook (blockHook), which the step runs at a point where the engine is whole and which may
+// read it and set conditions on cells (the engine refuses the rest, FlowEngine::mesh_hook).
 struct SharedEngine : FlowEngine {
   mutable std::mutex busy;
   mutable std::atomic<std::thread::id> holder{};
+  mutable std::atomic<bool> hook_running{false};
 };
 
 class EngineLock {
  public:
   explicit EngineLock(const SharedEngine& e) : engine_(e), lock_(e.busy, std::defer_lock) {
-    if (e.holder.load() == std::this_thread::get_id())
+    if (e.holder.load() == std::this_thread::get_id()) {
+      if (e.hook_running.load()) return;  // inside the step's own lock: nothing to take
       throw std::runtime_error(
           "pfv.Engine called from inside its own step (a boundary-pressure function must not call the engine; "
           "compute what it needs before the step)");
+    }
     if (!lock_.try_lock()) {
       py::gil_scoped_release release;
       lock_.lock();
     }
     e.holder.store(std::this_thread::get_id());
   }
-  ~EngineLock() { engine_.holder.store(std::thread::id{}); }  // before the lock is released
+  ~EngineLock() {
+    if (lock_.owns_lock()) engine_.holder.store(std::thread::id{});  // before the lock is released
+  }
   EngineLock(const EngineLock&) = delete;
   EngineLock& operator=(const EngineLock&) = delete;
 

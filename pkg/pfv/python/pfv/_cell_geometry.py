@@ -69,7 +69,7 @@ class CellGeometry:
 
     def mesh_key(self) -> tuple:
         """Changes with every remesh and step: what results kept for queries are valid for."""
-        return (self._core.remesh_count, self._history.last_step)
+        return (self._core.mesh_id, self._history.last_step)
 
     def nCells(self) -> int:
         return self._core.n_cells()

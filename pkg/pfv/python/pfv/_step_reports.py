@@ -1,5 +1,5 @@
 """What a pfv.FlowEngine runs and prints around its steps on request, a part of the engine: YADE's
-blockHook (Python code run at each remesh, between the new mesh and its linear system), debug,
+blockHook (Python code the core runs for every new mesh, between the mesh and its linear system), debug,
 getCHOLMODPerfTimings and meanKStat. With none of them on, a step does not look here again.
 """
 from __future__ import annotations
@@ -27,9 +27,10 @@ class StepReports:
     # -- YADE's attributes ------------------------------------------------------------------------
     @property
     def blockHook(self) -> str:
-        """Python code run in __main__ at each remesh, after the new mesh is built and before its linear
-        system: the place for blockCell and other conditions on the new cells (a background remesh, with
-        multithread, runs it after the new mesh is adopted: its conditions apply from the next step)."""
+        """Python code run in __main__ for every new mesh, after the mesh is built and before its linear
+        system: the place for blockCell and other conditions on the new cells. The core runs it on every
+        mesh, whichever way it came (the step's own remesh, one built in the background with multithread,
+        one forced by inverted cells), so its conditions hold from the mesh's first step."""
         return self._block_hook
 
     @blockHook.setter
@@ -39,6 +40,7 @@ class StepReports:
         if value.strip():
             compile(value, "blockHook", "exec")  # a syntax error now, not at the next remesh
         self._block_hook = value
+        self._core.set_mesh_hook(self.run_block_hook if value.strip() else None)
         self._update()
 
     @property
@@ -75,11 +77,6 @@ class StepReports:
         self.active = bool(self._debug or self._perf_timings or self._mean_k_stat or self._block_hook)
 
     # -- around a step ------------------------------------------------------------------------------
-    def hooks_remesh(self, remeshing: bool) -> bool:
-        """Whether the step must remesh apart and run blockHook before the new mesh's system: a remesh in
-        the step itself (a background remesh runs it after adoption instead, after_step)."""
-        return bool(self._block_hook) and remeshing and not self._core.background_remesh
-
     def run_block_hook(self) -> None:
         import __main__
 
@@ -90,14 +87,12 @@ class StepReports:
         return (self._core.remesh_count, self._core.system_builds) if self.active else None
 
     def after_step(self, before: tuple[int, int] | None) -> None:
-        """blockHook for a background remesh, and the reports that are on."""
+        """The reports that are on."""
         if before is None:
             return
         core = self._core
         remeshed = core.remesh_count != before[0]
         rebuilt = core.system_builds != before[1]
-        if remeshed and self._block_hook and core.background_remesh:
-            self.run_block_hook()
         if self._perf_timings and rebuilt:
             t = core.system_times()
             print(
@@ -137,7 +132,7 @@ class StepReports:
         }
 
     def restore(self, state: dict[str, Any]) -> None:
-        self._block_hook = state["block_hook"]
+        self.blockHook = state["block_hook"]
         self._debug = state["debug"]
         self._perf_timings = state["perf_timings"]
         self._mean_k_stat = state["mean_k_stat"]

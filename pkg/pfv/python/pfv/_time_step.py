@@ -59,7 +59,7 @@ class TimeStepGuard:
         # The mesh, the viscosity of its conductances (a new one applies at the next step), and the
         # shear term, which adds damping to the operator (switched on, its pairs arrive with a
         # remesh, which recomputes again).
-        return core.remesh_count, core.mesh_viscosity, core.viscous_shear
+        return core.mesh_id, core.mesh_viscosity, core.viscous_shear
 
     def stale(self, core: Any) -> bool:
         """Whether the core has a mesh, or conductances, the collective limit was not computed for."""
@@ -90,7 +90,7 @@ class TimeStepGuard:
             self._history.append(
                 dict(
                     iter=iteration,
-                    remesh_count=state[0],
+                    remesh_count=core.remesh_count,
                     limit=self._bound,
                     iterations=0,
                     max_iterations=0,
@@ -128,7 +128,7 @@ class TimeStepGuard:
             self._history.append(
                 dict(
                     iter=iteration,
-                    remesh_count=state[0],
+                    remesh_count=core.remesh_count,
                     limit=limit,
                     iterations=applied,
                     max_iterations=iterations,

@@ -352,11 +352,24 @@ class FlowEngine(PyRunner):
     # -- the step ---------------------------------------------------------------------------
     @exclusive
     def _step(self) -> None:
+        """One step, all or nothing: if any part fails (the core's step, blockHook, a boundary load, the
+        time-step guard after a new mesh, the forces to YADE), the core is put back as it was before
+        the step (its mesh, system, results and history) and the exception goes to YADE."""
         if not self._options.pressureForce:  # YADE's pressureForce=False: no flow at all
             return
         scene = yade.O
         clock = StepClock(self._timings) if scene.timingEnabled else _IDLE_CLOCK
         self._enter_scene(scene)
+        stepped = self._bodies.stepped
+        try:
+            self._step_parts(scene, clock)
+        except BaseException:
+            self._bodies.stepped = stepped
+            self._core.retract_step()
+            raise
+        self._core.accept_step()
+
+    def _step_parts(self, scene: Any, clock: Any) -> None:
         scan, pos, walls = self._bodies.for_step(scene)
         set_num_threads(self._threads or scene.numThreads)
         clock.lap("scan and positions")
@@ -364,14 +377,14 @@ class FlowEngine(PyRunner):
         watch, reports = StepWatch(self._core), self._reports.before_step()
         self._options.correct_volumes(pos, scan.radii)
         clock.lap("time-step guard")
-        self._advance(scene, scan, pos, walls, dt, watch.remeshing)
+        self._advance(scene, scan, pos, walls, dt)
         clock.core_step(self._core, watch.remeshed(self._core))
-        self._record(scene, scan, dt)
         self._time_step.check_new_mesh(scene.dt, scan)
         self._warnings.after_step(self._core, scene.iter, scan, watch)
         clock.lap("time-step guard and warnings")
         self._reports.after_step(reports)
         self._apply_forces(scene, scan)
+        self._record(scene, scan, dt)
         clock.lap("forces to YADE")
 
     def _enter_scene(self, scene: Any) -> None:
@@ -397,20 +410,15 @@ class FlowEngine(PyRunner):
         self._time_step.check(scene.dt, scan, before_step=True)
         return dt
 
-    def _advance(
-        self, scene: Any, scan: SceneScan, pos: np.ndarray, walls: list[float], dt: float, remeshing: bool
-    ) -> None:
-        """The core's step: remesh when due, dV/dt, solve, forces; with a load evaluated at this step's
-        time, and blockHook between a new mesh and its linear system."""
-        core = self._core
+    def _advance(self, scene: Any, scan: SceneScan, pos: np.ndarray, walls: list[float], dt: float) -> None:
+        """The core's step: remesh when due (blockHook between a new mesh and its system, in the core),
+        dV/dt, solve, forces; with a load evaluated at this step's time."""
         if self._loads.active:
             self._loads.prepare(scene, walls)
+        # The spheres of any mesh the step builds: what blockHook's queries name.
+        self._bodies.stepped = scan
         with self._bodies.named_in_errors(scan):
-            if self._reports.hooks_remesh(remeshing):
-                core.remesh(pos, scan.radii, walls)  # without a linear system: blockHook sets conditions first
-                self._bodies.stepped = scan
-                self._reports.run_block_hook()
-            core.step(pos, scan.radii, walls, dt)
+            self._core.step(pos, scan.radii, walls, dt)
 
     def _record(self, scene: Any, scan: SceneScan, dt: float) -> None:
         """A step made: the mesh holds the spheres of `scan`; `dt` the time its dV/dt spanned."""

@@ -6,8 +6,11 @@
 #include <array>
 #include <vector>
 
-#include "pfv/linalg/schedule_choice.hpp"
+#include "pfv/common/parallel.hpp"
+#include "pfv/common/schedule_choice.hpp"
 
+using pfv::kMinParallelLoop;
+using pfv::LoopChoice;
 using pfv::ScheduleChoice;
 
 namespace {
@@ -59,4 +62,46 @@ TEST(ScheduleChoice, OnlyTheAvailableSchedules) {
   const auto count = run(c, 2, {1.0, 0.5, 0.1}, 100);  // no shared top: schedule 2 never runs
   EXPECT_EQ(count[2], 0);
   EXPECT_GT(count[1], 90);
+}
+
+#ifdef _OPENMP
+// Sets the calling thread's OpenMP thread count while in scope.
+class ThreadCount {
+ public:
+  explicit ThreadCount(int n) : before_(omp_get_max_threads()) { omp_set_num_threads(n); }
+  ~ThreadCount() { omp_set_num_threads(before_); }
+  ThreadCount(const ThreadCount&) = delete;
+  ThreadCount& operator=(const ThreadCount&) = delete;
+
+ private:
+  int before_;
+};
+#endif
+
+TEST(LoopChoice, ATeamOnlyForLongLoopsOnSeveralThreads) {
+#ifdef _OPENMP
+  const ThreadCount one_thread(1);
+#endif
+  LoopChoice c;
+  for (int k = 0; k < 20; ++k) {
+    EXPECT_FALSE(c.team(10 * kMinParallelLoop));  // one thread: nothing to choose
+    c.done(1.0);
+  }
+#ifdef _OPENMP
+  const ThreadCount two_threads(2);
+  LoopChoice d;
+  for (int k = 0; k < 20; ++k) {
+    EXPECT_FALSE(d.team(kMinParallelLoop));  // too short to pay
+    d.done(1.0);
+  }
+  // Long loops: the team is tried first; a team three times slower (busy cores) then loses.
+  int teams = 0;
+  for (int k = 0; k < 200; ++k) {
+    const bool team = d.team(10 * kMinParallelLoop);
+    teams += team;
+    d.done(team ? 3.0 : 1.0);
+  }
+  EXPECT_GE(teams, 1);
+  EXPECT_LE(teams, 20);
+#endif
 }

@@ -6,6 +6,8 @@
 #include <omp.h>
 #endif
 
+#include "pfv/common/schedule_choice.hpp"
+
 namespace pfv {
 
 // Loops shorter than this run on one thread: waking a thread team costs more than the loop,
@@ -20,5 +22,25 @@ inline int max_threads() {
   return 1;
 #endif
 }
+
+// One thread or the team for a loop run at every step, by the time each took (ScheduleChoice):
+// on free cores the team pays from kMinParallelLoop items on, on cores other processes hold the
+// fork and join wait for a descheduled thread and one thread is many times faster. The loop must
+// give the same bits either way.
+class LoopChoice {
+ public:
+  // Whether this run of a loop of 'items' goes to the team; then done() with its time.
+  bool team(long items) {
+    measured_ = items > kMinParallelLoop && max_threads() > 1;
+    return measured_ && choice_.pick(2) == 1;
+  }
+  void done(double seconds) {
+    if (measured_) choice_.record(2, seconds);
+  }
+
+ private:
+  ScheduleChoice<2> choice_;
+  bool measured_ = false;
+};
 
 }  // namespace pfv

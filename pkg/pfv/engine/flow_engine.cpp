@@ -1,6 +1,7 @@
 #include "pfv/engine/flow_engine.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -185,27 +186,44 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   // the slivers of a dense packing (volumes far below the mean) flip under any small motion,
   // harmlessly, and must not count.
   const double inside_out = -kInversionFraction * mesh_->mean_cell_volume;
-  int inverted_cells = 0;
-  double inverted_volume = 0, meshed_volume = 0;
   next_volume_.resize(nc);
   next_volume_rate_.resize(nc);
-#pragma omp parallel for schedule(static) reduction(max : max_change) \
-    reduction(+ : inverted_cells, inverted_volume, meshed_volume) if (nc > kMinParallelLoop)
-  for (int c = 0; c < nc; ++c) {
-    const CellShape& shape = mesh_->cells.shape[c];
-    const double v = cell_volume(shape, centres, walls);
-    const bool inverted = v < inside_out;
-    inverted_cells += inverted;
-    inverted_volume += inverted ? -v : 0.0;
-    meshed_volume += std::abs(v);
-    const double dv = has_prev_ ? v - volume_[c] : 0.0;
-    next_volume_rate_[c] = dv / dt;
-    max_change = std::max(max_change, std::abs(dv) / std::max(v, mesh_->mean_cell_volume));
-    next_volume_[c] = v;
+  // The sums over cells by fixed chunks, added in order: the same bits on one thread or on the
+  // team, whichever the measured choice runs (the inversion rule must not depend on the load).
+  constexpr int kChunks = 64;
+  std::array<int, kChunks> inverted_in{};
+  std::array<double, kChunks> inverted_volume_in{}, meshed_volume_in{};
+  const bool team = volume_loop_.team(nc);
+  const auto loop_start = StageClock::now();
+#pragma omp parallel for schedule(static) reduction(max : max_change) if (team)
+  for (int k = 0; k < kChunks; ++k) {
+    const int end = static_cast<int>(static_cast<long long>(nc) * (k + 1) / kChunks);
+    int inverted_here = 0;
+    double inverted_volume_here = 0, meshed_volume_here = 0;
+    for (int c = static_cast<int>(static_cast<long long>(nc) * k / kChunks); c < end; ++c) {
+      const CellShape& shape = mesh_->cells.shape[c];
+      const double v = cell_volume(shape, centres, walls);
+      const bool inverted = v < inside_out;
+      inverted_here += inverted;
+      inverted_volume_here += inverted ? -v : 0.0;
+      meshed_volume_here += std::abs(v);
+      const double dv = has_prev_ ? v - volume_[c] : 0.0;
+      next_volume_rate_[c] = dv / dt;
+      max_change = std::max(max_change, std::abs(dv) / std::max(v, mesh_->mean_cell_volume));
+      next_volume_[c] = v;
+    }
+    inverted_in[k] = inverted_here;
+    inverted_volume_in[k] = inverted_volume_here;
+    meshed_volume_in[k] = meshed_volume_here;
   }
-  inverted_cells_ = inverted_cells;
-  inverted_volume_ = inverted_volume;
-  meshed_volume_ = meshed_volume;
+  volume_loop_.done(seconds_since(loop_start));
+  inverted_cells_ = 0;
+  inverted_volume_ = meshed_volume_ = 0;
+  for (int k = 0; k < kChunks; ++k) {
+    inverted_cells_ += inverted_in[k];
+    inverted_volume_ += inverted_volume_in[k];
+    meshed_volume_ += meshed_volume_in[k];
+  }
   if (settings.volume_correction != 1)
     for (int c = 0; c < nc; ++c)
       if (mesh_->cells.shape[c].n_walls == 0) next_volume_rate_[c] *= settings.volume_correction;
@@ -262,7 +280,9 @@ void FlowEngine::solve(double dt) {
 
 void FlowEngine::compute_forces(const std::vector<Vec3>& centres, const std::vector<double>& radii, double dt) {
   auto t0 = StageClock::now();
-  mesh_->cache.apply(next_pressure_, next_force_);
+  const bool team = force_loop_.team(mesh_->cache.n_terms());
+  mesh_->cache.apply(next_pressure_, next_force_, team);
+  force_loop_.done(seconds_since(t0));
   if (settings.fluid_density > 0) {
     const Vec3 weight = settings.fluid_density * (4.0 / 3.0) * std::numbers::pi * settings.gravity;
     for (std::size_t k = 0; k < radii.size(); ++k) next_force_[k] -= radii[k] * radii[k] * radii[k] * weight;

@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "pfv/common/parallel.hpp"
 #include "pfv/engine/engine_settings.hpp"
 #include "pfv/engine/linear_system.hpp"
 #include "pfv/engine/pore_mesh.hpp"
@@ -276,6 +277,8 @@ class FlowEngine {
   bool system_rebuild_requested_ = false;
   StageTimes remesh_times_, step_times_;
   long mesh_id_ = 0;
+  // One thread or the team for the loops of dV/dt and of the forces, by their measured times.
+  LoopChoice volume_loop_, force_loop_;
   bool in_hook_ = false;  // mesh_hook is running
   Undo undo_;
 };

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "pfv/linalg/schedule_choice.hpp"
+#include "pfv/common/schedule_choice.hpp"
 
 namespace pfv {
 

@@ -47,12 +47,12 @@ void ForceCache::build(const Mesh& mesh, const FacetGeometry& facets, const Pack
     }
 }
 
-void ForceCache::apply(const std::vector<double>& p, std::vector<Vec3>& force) const {
+void ForceCache::apply(const std::vector<double>& p, std::vector<Vec3>& force, bool team) const {
   const int nv = n_vertices();
   force.resize(nv);
   // The work is one term per (sphere, incident cell), about 23 per sphere: 10 000 spheres are
   // worth a team, though fewer than kMinParallelLoop loop items.
-#pragma omp parallel for schedule(static) if (start_[nv] > kMinParallelLoop)
+#pragma omp parallel for schedule(static) if (team && start_[nv] > kMinParallelLoop)
   for (int v = 0; v < nv; ++v) {
     Vec3 f = Vec3::Zero();
     for (int e = start_[v]; e < start_[v + 1]; ++e) f += p[cell_[e]] * unit_[e];

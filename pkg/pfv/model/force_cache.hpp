@@ -18,12 +18,15 @@ class ForceCache {
  public:
   void build(const Mesh& mesh, const FacetGeometry& facets, const Packing& packing);
   // force[v] for every mesh vertex (spheres, then the six walls).
-  void apply(const std::vector<double>& cell_pressure, std::vector<Vec3>& force) const;
+  // team: on the OpenMP team (the same bits as on one thread).
+  void apply(const std::vector<double>& cell_pressure, std::vector<Vec3>& force, bool team = true) const;
   // bound[v][a] = sum over cells c of |S(v, c)[a]| cell_value[c]: with nonnegative values, a
   // bound on |force[v][a]| for any pressures of magnitude at most cell_value (the row sums of
   // |S| that the collective time-step bound needs, viscous_stability.cpp).
   void apply_magnitude(const std::vector<double>& cell_value, std::vector<Vec3>& bound) const;
   int n_vertices() const { return static_cast<int>(start_.size()) - 1; }
+  // The (sphere, incident cell) terms apply() sums.
+  int n_terms() const { return start_.empty() ? 0 : start_.back(); }
   // Vertex v's terms: force[v] = sum over k of cell_pressure[cells(v)[k]] * units(v)[k].
   std::span<const int> cells(int v) const { return {cell_.data() + start_[v], cell_.data() + start_[v + 1]}; }
   std::span<const Vec3> units(int v) const { return {unit_.data() + start_[v], unit_.data() + start_[v + 1]}; }

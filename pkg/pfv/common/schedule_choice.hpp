@@ -1,6 +1,7 @@
 // Picks one of a few schedules of a computation that give the same result to the bit, by the
 // time each took on this machine: the parallel substitution's serial, two-group and shared-top
-// schedules (parallel_substitution.hpp).
+// schedules (parallel_substitution.hpp), and one thread or the team for the engine's loops over
+// cells and spheres at each step (flow_engine.cpp).
 //
 // On free cores a team pays; on cores other processes hold, every barrier and every fork waits
 // for a descheduled thread, up to a scheduler time slice each, and the schedule with the fewest

@@ -260,8 +260,7 @@ void FlowEngine::compute_forces(const std::vector<Vec3>& centres, const std::vec
       if (!(radii[k] * radii[k] * radii[k] * weight).allFinite())
         throw std::domain_error("the buoyancy of sphere " + std::to_string(k) +
                                 ", fluid_density x its volume x gravity, is not finite (fluid_density = " +
-                                describe(settings.fluid_density) + ", gravity = " + describe(settings.gravity) +
-                                ")");
+                                describe(settings.fluid_density) + ", gravity = " + describe(settings.gravity) + ")");
   }
   step_times_.forces = seconds_since(t0);
 

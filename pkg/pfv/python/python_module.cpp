@@ -82,8 +82,8 @@ const SolverKind kSolvers[] = {SolverKind::kGaussSeidel, SolverKind::kConjugateG
                                SolverKind::kMultigrid, SolverKind::kAuto};
 const MultigridSmoother kSmoothers[] = {MultigridSmoother::kGaussSeidel, MultigridSmoother::kJacobi,
                                         MultigridSmoother::kSplitGaussSeidel};
-const Ordering kOrderings[] = {Ordering::kAuto,    Ordering::kAmd,     Ordering::kMetis,
-                               Ordering::kNestedDissection, Ordering::kCholmod, Ordering::kGeometric};
+const Ordering kOrderings[] = {Ordering::kAuto,    Ordering::kAmd,      Ordering::kMetis, Ordering::kNestedDissection,
+                               Ordering::kCholmod, Ordering::kGeometric};
 std::string name_of(SolverKind k) { return std::string(to_string(k)); }
 std::string name_of(MultigridSmoother k) { return std::string(to_string(k)); }
 std::string name_of(Ordering k) {

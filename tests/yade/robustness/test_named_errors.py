@@ -6,9 +6,9 @@ numpy scalars wherever Python's ints and floats are taken.
 1. Every message of the C++ core that names a vertex (a sphere or a wall by its place in the
    engine's arrays) must say "sphere k" or "wall w", the forms pfv.FlowEngine turns into YADE's body
    ids: read off the sources, so that a new message cannot name a vertex.
-2. Steps that fail on settings or boundary values out of the physical range (fluid_density,
-   boundary pressures, imposed fluxes whose results overflow) name the setting or the YADE body
-   (#id) and the place, and no internal index; the engine then steps as before.
+2. Steps that fail on values out of the physical range (a fluid_density whose buoyancy overflows,
+   an imposed flux whose pressures do) name the setting or the YADE body (#id) and the place, and
+   no internal index; the engine then steps as before.
 3. Every method that takes a body id, a cell id, a wall, a condition index or a number gives the
    same answer for numpy integers and floats (np.int64, np.int32, np.uint16, np.float64,
    np.float32) as for Python's.
@@ -75,15 +75,25 @@ q_ref = flow.getBoundaryFlux(2)
 first_sphere = min(b.id for b in O.bodies if b.id not in flow.wallIds)
 newton = [e for e in O.engines if isinstance(e, NewtonIntegrator)][0]
 newton.gravity = (0, -9.81, 0)  # buoyancy acts with the NewtonIntegrator's gravity
+# (what, change, undo, fragments the message must hold)
 failures = [
-    ("fluid_density = 1e308", "fluid_density", 1e308, ["fluid_density", f"sphere #{first_sphere}"]),
-    ("bndCondValue of 1e308", "bndCondValue", [0, 0, 1e308, -1e308, 0, 0], ["non-finite"]),
+    (
+        "fluid_density = 1e308",
+        lambda: setattr(flow, "fluid_density", 1e308),
+        lambda: setattr(flow, "fluid_density", 0.0),
+        ["fluid_density", f"sphere #{first_sphere}"],
+    ),
+    (
+        "an imposed flux of 1e308",
+        lambda: flow.imposeFlux((0.5, 0.5, 0.5), 1e308),
+        flow.clearImposedFlux,
+        ["non-finite pore pressure", " at (", "imposed fluxes"],
+    ),
 ]
-for what, name, value, fragments in failures:
-    before = getattr(flow, name)
-    setattr(flow, name, value)
+for what, change, undo, fragments in failures:
+    change()
     fails_named(what, fragments, step)
-    setattr(flow, name, before)
+    undo()
 flow.fluid_density = 0.0
 newton.gravity = (0, 0, 0)
 step()

@@ -11,7 +11,8 @@ numpy scalars wherever Python's ints and floats are taken.
    no internal index; the engine then steps as before.
 3. Every method that takes a body id, a cell id, a wall, a condition index or a number gives the
    same answer for numpy integers and floats (np.int64, np.int32, np.uint16, np.float64,
-   np.float32) as for Python's.
+   np.float32) as for Python's, and refuses a float, a string or a bool where an index belongs
+   (TypeError) instead of truncating or parsing it.
 """
 import os
 import re
@@ -163,8 +164,30 @@ def equal(a, b):
     return repr(a) == repr(b)
 
 
-calls = 0
+def refused_indices(method, args):
+    """A float of the same value, its string or a bool in place of each integer argument: TypeError."""
+    problems = []
+    for position, (value, kind) in enumerate(args):
+        if kind != INT:
+            continue
+        for bad in (float(value), str(value), bool(value)):
+            given = [v for v, _ in args]
+            given[position] = bad
+            try:
+                getattr(flow, method)(*given)
+                problems.append(f"{bad!r} taken")
+            except TypeError:
+                pass
+            except Exception as error:  # noqa: BLE001
+                problems.append(f"{bad!r}: {type(error).__name__}: {error}")
+    return problems
+
+
+calls = refusals = 0
 for method, args in queries:
+    problems = refused_indices(method, args)
+    refusals += 3 * sum(kind == INT for _, kind in args)
+    rb.check(f"{method} refuses a float, a string or a bool as an index", not problems, "; ".join(problems[:3]))
     problems = []
     for what, given, plain in numpy_calls(method, args):
         calls += 1
@@ -197,5 +220,8 @@ for name, change, _ in changes:
     rb.check(f"{name} takes numpy integers", not problems, "; ".join(problems[:3]))
 rb.check("set_boundary_pressure's wall is a Python int again", type(flow.boundary_pressure[0]) is int)
 flow.clear_boundary_pressure()
-print(f"{len(queries)} queries and {len(changes)} changes, {calls} calls with numpy scalars")
+print(
+    f"{len(queries)} queries and {len(changes)} changes, {calls} calls with numpy scalars, "
+    f"{refusals} indices of the wrong type refused"
+)
 rb.report("named-errors")

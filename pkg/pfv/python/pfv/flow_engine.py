@@ -538,14 +538,15 @@ class FlowEngine(PyRunner):
 
 # Names set as ordinary attributes: PyRunner's (command, iterPeriod, label, ...) and the properties
 # of FlowEngine (its own and those forwarded to its parts).
-# YADE's PyRunner attributes that are not FlowEngine's own properties (ompThreads, timingDeltas).
+_OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
+    name for klass in FlowEngine.__mro__ for name, v in vars(klass).items() if isinstance(v, property)
+}
+# YADE's PyRunner attributes, checked by YADE's converters: all but FlowEngine's own properties
+# (ompThreads, timingDeltas).
 _RUNNER_ATTRIBUTES = frozenset(
     a
     for a in dir(PyRunner)
     if not a.startswith("_") and not callable(getattr(PyRunner, a)) and a not in vars(FlowEngine)
 )
-_OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
-    name for klass in FlowEngine.__mro__ for name, v in vars(klass).items() if isinstance(v, property)
-}
 
 _persistence.install()  # O.save / O.load carry the engines' state

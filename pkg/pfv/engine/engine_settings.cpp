@@ -58,7 +58,7 @@ void validate(const EngineSettings& s) {
   require(s.gravity.allFinite(), "gravity must be finite");
   require(s.fluid_bulk_modulus >= 0 && std::isfinite(s.fluid_bulk_modulus),
           named("fluidBulkModulus", s.fluid_bulk_modulus, ">= 0 and finite"));
-  require(!std::isnan(s.flat_threshold), "flatThreshold must be a number (got nan)");
+  require(std::isfinite(s.flat_threshold), named("flatThreshold", s.flat_threshold, "finite (negative: none)"));
   require(finite_positive(s.volume_correction), named("volumeCorrection", s.volume_correction, "positive and finite"));
   require(s.minimum_porosity >= 0 && s.minimum_porosity < 1, named("minimumPorosity", s.minimum_porosity, "in [0, 1)"));
 }

@@ -286,6 +286,12 @@ void FlowEngine::compute_forces(const std::vector<Vec3>& centres, const std::vec
   if (settings.fluid_density > 0) {
     const Vec3 weight = settings.fluid_density * (4.0 / 3.0) * std::numbers::pi * settings.gravity;
     for (std::size_t k = 0; k < radii.size(); ++k) next_force_[k] -= radii[k] * radii[k] * radii[k] * weight;
+    // Named here, where the cause is known: the settings, not a force of unknown origin below.
+    for (std::size_t k = 0; k < radii.size(); ++k)
+      if (!(radii[k] * radii[k] * radii[k] * weight).allFinite())
+        throw std::domain_error("the buoyancy of sphere " + std::to_string(k) +
+                                ", fluid_density x its volume x gravity, is not finite (fluid_density = " +
+                                describe(settings.fluid_density) + ", gravity = " + describe(settings.gravity) + ")");
   }
   step_times_.forces = seconds_since(t0);
 
@@ -311,11 +317,20 @@ void FlowEngine::commit(const std::vector<Vec3>& centres, const BoxWalls& walls,
   // Never hand NaN or infinite forces back to the DEM.
   const auto bad_p =
       std::find_if(next_pressure_.begin(), next_pressure_.end(), [](double x) { return !std::isfinite(x); });
-  if (bad_p != next_pressure_.end())
-    throw std::domain_error("non-finite pore pressure in cell " + std::to_string(bad_p - next_pressure_.begin()) +
+  if (bad_p != next_pressure_.end()) {
+    const auto cell = bad_p - next_pressure_.begin();
+    throw std::domain_error("non-finite pore pressure in cell " + std::to_string(cell) + " at " +
+                            describe(mesh_->cells.power_centre[cell]) +
                             " (check boundary values, imposed fluxes and the time step)");
+  }
+  // Vertices are the spheres in input order, then the six walls: named so (the caller maps them to
+  // its own ids, as for every message of the step).
+  const std::size_t spheres = next_force_.size() - static_cast<std::size_t>(kWallCount);
   for (std::size_t v = 0; v < next_force_.size(); ++v)
-    if (!next_force_[v].allFinite()) throw std::domain_error("non-finite fluid force on vertex " + std::to_string(v));
+    if (!next_force_[v].allFinite())
+      throw std::domain_error("non-finite fluid force on " +
+                              (v < spheres ? "sphere " + std::to_string(v) : "wall " + std::to_string(v - spheres)) +
+                              " (check viscosity, fluid_density, boundary values and the time step)");
 
   // From here on nothing throws. Each replaced buffer stays where retract_step() finds it.
   undo_.committed = true;

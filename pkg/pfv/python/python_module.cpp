@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
-#include <map>
 #include <mutex>
 #include <string>
 #include <tuple>
@@ -77,6 +76,36 @@ auto set_setting(T Owner::*field) {
   return exclusive([field](SharedEngine& e, T v) {
     update(e, [&](EngineSettings& s) { owner(s, static_cast<Owner*>(nullptr)).*field = v; });
   });
+}
+
+// The settings that take one of a few strings: the values, each named by name_of().
+const SolverKind kSolvers[] = {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient, SolverKind::kCholesky,
+                               SolverKind::kMultigrid, SolverKind::kAuto};
+const MultigridSmoother kSmoothers[] = {MultigridSmoother::kGaussSeidel, MultigridSmoother::kJacobi,
+                                        MultigridSmoother::kSplitGaussSeidel};
+const Ordering kOrderings[] = {Ordering::kAuto,    Ordering::kAmd,      Ordering::kMetis, Ordering::kNestedDissection,
+                               Ordering::kCholmod, Ordering::kGeometric};
+std::string name_of(SolverKind k) { return std::string(to_string(k)); }
+std::string name_of(MultigridSmoother k) { return std::string(to_string(k)); }
+std::string name_of(Ordering k) {
+  const char* names[] = {"auto", "amd", "metis", "nesdis", "cholmod", "geometric"};
+  return names[static_cast<int>(k)];
+}
+
+// The value among `kinds` that the string `v` names: TypeError if `v` is no string, ValueError if it
+// names none of them, both naming the setting and the strings it takes.
+template <class Kind, std::size_t N>
+Kind choose(const char* setting, const py::object& v, const Kind (&kinds)[N]) {
+  const bool text = py::isinstance<py::str>(v);
+  std::string names;
+  for (Kind k : kinds) {
+    if (text && v.cast<std::string>() == name_of(k)) return k;
+    names += (names.empty() ? "" : ", ") + name_of(k);
+  }
+  const std::string message =
+      std::string(setting) + " must be one of " + names + "; got " + py::repr(v).cast<std::string>();
+  if (text) throw py::value_error(message);
+  throw py::type_error(message);
 }
 
 // Appends a point condition (YADE's imposePressure, imposeFlux) and returns its index. Refused
@@ -167,15 +196,9 @@ PYBIND11_MODULE(_core, m) {
           "next step.")
       .def_property("solver",
                     exclusive([](const SharedEngine& e) { return std::string(to_string(e.settings.solver)); }),
-                    exclusive([](SharedEngine& e, const std::string& v) {
-                      const SolverKind kinds[] = {SolverKind::kGaussSeidel, SolverKind::kConjugateGradient,
-                                                  SolverKind::kCholesky, SolverKind::kMultigrid, SolverKind::kAuto};
-                      for (SolverKind k : kinds)
-                        if (v == to_string(k)) return update(e, [&](EngineSettings& s) { s.solver = k; });
-                      throw py::value_error(
-                          "solver must be one of gauss_seidel, conjugate_gradient, cholesky, "
-                          "multigrid, auto; got '" +
-                          v + "'");
+                    exclusive([](SharedEngine& e, const py::object& v) {
+                      const SolverKind k = choose("solver", v, kSolvers);
+                      update(e, [&](EngineSettings& s) { s.solver = k; });
                     }),
                     "auto (default): the Cholesky factor unless it would exceed max_factor_bytes or CHOLMOD's 32-bit "
                     "index range, then multigrid.")
@@ -186,13 +209,9 @@ PYBIND11_MODULE(_core, m) {
       .def_property(
           "multigrid_smoother",
           exclusive([](const SharedEngine& e) { return std::string(to_string(e.settings.multigrid_smoother)); }),
-          exclusive([](SharedEngine& e, const std::string& v) {
-            const MultigridSmoother kinds[] = {MultigridSmoother::kGaussSeidel, MultigridSmoother::kJacobi,
-                                               MultigridSmoother::kSplitGaussSeidel};
-            for (MultigridSmoother k : kinds)
-              if (v == to_string(k)) return update(e, [&](EngineSettings& s) { s.multigrid_smoother = k; });
-            throw py::value_error("multigrid_smoother must be one of gauss_seidel, jacobi, split_gauss_seidel; got '" +
-                                  v + "'");
+          exclusive([](SharedEngine& e, const py::object& v) {
+            const MultigridSmoother k = choose("multigrid_smoother", v, kSmoothers);
+            update(e, [&](EngineSettings& s) { s.multigrid_smoother = k; });
           }),
           "The multigrid V-cycle's smoother: gauss_seidel (default; symmetric l1-scaled sweeps on the way down and "
           "up), jacobi (l1-scaled; cheaper for a fixed skeleton) or split_gauss_seidel (one forward sweep down, one "
@@ -204,19 +223,10 @@ PYBIND11_MODULE(_core, m) {
       .def_property("max_iterations", get_setting(&EngineSettings::max_iterations),
                     set_setting(&EngineSettings::max_iterations))
       .def_property("force_metis", get_setting(&EngineSettings::force_metis), set_setting(&EngineSettings::force_metis))
-      .def_property("ordering", exclusive([](const SharedEngine& e) {
-                      const char* names[] = {"auto", "amd", "metis", "nesdis", "cholmod", "geometric"};
-                      return std::string(names[static_cast<int>(e.settings.ordering)]);
-                    }),
-                    exclusive([](SharedEngine& e, const std::string& v) {
-                      const std::map<std::string, Ordering> names{
-                          {"auto", Ordering::kAuto},       {"amd", Ordering::kAmd},
-                          {"metis", Ordering::kMetis},     {"nesdis", Ordering::kNestedDissection},
-                          {"cholmod", Ordering::kCholmod}, {"geometric", Ordering::kGeometric}};
-                      const auto it = names.find(v);
-                      if (it == names.end())
-                        throw py::value_error("ordering must be one of auto, amd, metis, nesdis, cholmod, geometric");
-                      update(e, [&](EngineSettings& s) { s.ordering = it->second; });
+      .def_property("ordering", exclusive([](const SharedEngine& e) { return name_of(e.settings.ordering); }),
+                    exclusive([](SharedEngine& e, const py::object& v) {
+                      const Ordering k = choose("ordering", v, kOrderings);
+                      update(e, [&](EngineSettings& s) { s.ordering = k; });
                     }))
       .def_property("mixed_precision", get_setting(&EngineSettings::mixed_precision),
                     set_setting(&EngineSettings::mixed_precision))

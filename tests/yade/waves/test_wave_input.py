@@ -63,6 +63,14 @@ bad = [
     ("infinite", ValueError, "not finite", lambda x, y, z, t: np.full(len(x), math.inf)),
     ("strings", TypeError, "must return numbers", lambda x, y, z, t: ["a"] * len(x)),
     ("None", TypeError, "must return numbers", lambda x, y, z, t: None),
+    # What numpy would convert: a number as a string, bools as 0 and 1, complex numbers without their
+    # imaginary part.
+    ("a number as a string", TypeError, "must return numbers", lambda x, y, z, t: "5.0"),
+    ("numbers as strings", TypeError, "must return numbers", lambda x, y, z, t: ["5.0"] * len(x)),
+    ("a bool", TypeError, "must return numbers", lambda x, y, z, t: True),
+    ("bools", TypeError, "must return numbers", lambda x, y, z, t: x > 0.5),
+    ("a complex number", TypeError, "must return numbers", lambda x, y, z, t: 5.0 + 0j),
+    ("complex numbers", TypeError, "must return numbers", lambda x, y, z, t: x + 0j),
 ]
 for what, kind, fragment, function in bad:
     flow.set_boundary_pressure(flow.ymax, function)

@@ -3,7 +3,8 @@
 ``from pfv import FlowEngine`` replaces YADE's built-in FlowEngine in a scene script.
 The C++ engine alone is ``pfv.Engine`` (usable without YADE).
 """
-from ._core import Engine, set_num_threads, get_max_threads  # noqa: F401
+from ._core import set_num_threads, get_max_threads  # noqa: F401
+from ._engine import Engine  # noqa: F401  (the core, its settings checked at assignment)
 from ._time_step import TimeStepWarning  # noqa: F401  (no YADE needed)
 from . import waves  # noqa: F401  (time-dependent boundary pressures; no YADE needed)
 from ._yade_version import check_running_yade

@@ -83,10 +83,23 @@ def default(name: str) -> Any:
 
 
 def check_default(name: str, value: Any) -> None:
-    """Accept `value` for the unsupported YADE attribute `name` only if it is YADE's default."""
+    """Accept `value` for the unsupported YADE attribute `name` only if it is YADE's default, given as
+    YADE's converter for the default's type would take it (a string, None or a complex number never
+    stands for a number or a flag, nor a number for a string)."""
     expected = default(name)
     try:
-        same = value == expected or (isinstance(expected, float) and float(value) == expected)
+        if isinstance(expected, bool):
+            value = as_flag(name, value)
+        elif isinstance(expected, int):
+            value = as_integer(name, value)
+        elif isinstance(expected, float):
+            value = as_number(name, value)
+        elif isinstance(expected, str) and not isinstance(value, str):
+            raise TypeError(f"{name} must be a string, got {value!r}")
+    except ValueError:  # NaN or inf: not the default either
+        pass
+    try:
+        same = bool(value == expected)
     except (TypeError, ValueError):
         same = False
     if not same:
@@ -110,9 +123,11 @@ def unknown_attribute(name: str, setting: bool) -> AttributeError:
 
 def solver_of_use_solver(value: int) -> str:
     """The core's solver name for YADE's useSolver number."""
+    value = as_integer("useSolver", value)
     if value not in _SOLVER_OF_USE_SOLVER:
         raise ValueError(
-            "useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG, PFV) or 3 (CHOLMOD, as solver='auto')"
+            "useSolver must be 0 (Gauss-Seidel), 1 (preconditioned CG, PFV) or 3 (CHOLMOD, as solver='auto'), "
+            f"got {value}"
         )
     return _SOLVER_OF_USE_SOLVER[value]
 
@@ -160,18 +175,21 @@ def as_float6(name: str, value: Iterable[Any]) -> list[float]:
 
 
 def as_wall_ids(value: Iterable[Any]) -> list[int]:
-    """Six body ids, one per wall (xmin, xmax, ymin, ymax, zmin, zmax): integers, not floats."""
-    return [int(v) for v in _six("wallIds", value, (numbers.Integral,), "body ids", "an integer body id")]
+    """Six body ids, one per wall (xmin, xmax, ymin, ymax, zmin, zmax): Python or numpy integers, not floats
+    or bools."""
+    items = _six("wallIds", value, (numbers.Integral,), "body ids", "an integer body id")
+    return [as_index(f"wallIds[{w}]", v) for w, v in enumerate(items)]
 
 
 def as_point(name: str, value: Any) -> tuple[float, float, float]:
-    """A finite point (x, y, z)."""
-    if isinstance(value, (str, bytes)):
-        raise TypeError(f"{name} must be a point (x, y, z) of numbers, got {value!r}")
+    """A finite point (x, y, z) of numbers (as_number: no strings)."""
     try:
-        point = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a point (x, y, z) of numbers, got {value!r}") from None
+        items = None if isinstance(value, (str, bytes)) else list(value)  # Vector3 iterates by index
+    except TypeError:
+        items = None
+    if items is None or not all(is_number(v) for v in items):
+        raise TypeError(f"{name} must be a point (x, y, z) of numbers, got {value!r}")
+    point = tuple(float(v) for v in items)
     if len(point) != 3 or not all(math.isfinite(v) for v in point):
         raise ValueError(f"{name} must be a finite point (x, y, z), got {value!r}")
     return point
@@ -180,21 +198,27 @@ def as_point(name: str, value: Any) -> tuple[float, float, float]:
 def as_setting(name: str, value: Any, current: Any) -> Any:
     """`value` checked for the core setting behind YADE attribute `name`, whose current value
     `current` gives the type: a flag (bool or integer), an integer, or a finite number. The core
-    checks the ranges; this names the attribute when the type is wrong."""
+    checks the ranges, and the strings a string setting takes; this names the attribute when the
+    type is wrong."""
     if isinstance(current, bool):
         return as_flag(name, value)
     if isinstance(current, int):
-        if not isinstance(value, numbers.Integral) or isinstance(value, (bool, np.bool_)):
-            raise TypeError(f"{name} must be an integer, got {value!r}")
-        return int(value)
+        return as_integer(name, value)
     if isinstance(current, float):
         return as_number(name, value)
     return value
 
 
+def is_number(value: Any) -> bool:
+    """A real number as YADE's float converter takes it (int, bool, float), or a numpy real scalar."""
+    return isinstance(value, (numbers.Real, np.bool_)) and not isinstance(value, (str, bytes))
+
+
 def as_number(name: str, value: Any) -> float:
-    """A finite float."""
-    if isinstance(value, (str, bytes)) or not isinstance(value, numbers.Real):
+    """A finite float: a Python int, bool or float as YADE's converter takes them, or a numpy real scalar
+    (YADE's refuses those but numpy.float64); a string, None, a complex number or a sequence raises
+    TypeError, NaN and inf ValueError."""
+    if not is_number(value):
         raise TypeError(f"{name} must be a number, got {value!r}")
     value = float(value)
     if not math.isfinite(value):
@@ -202,9 +226,32 @@ def as_number(name: str, value: Any) -> float:
     return value
 
 
+def as_positive(name: str, value: Any) -> float:
+    """A positive finite float."""
+    value = as_number(name, value)
+    if value <= 0:
+        raise ValueError(f"{name} must be positive, got {value!r}")
+    return value
+
+
+# The range of a C int: the core's integer settings.
+INT_MIN, INT_MAX = -(2**31), 2**31 - 1
+
+
+def as_integer(name: str, value: Any, low: int = INT_MIN, high: int = INT_MAX) -> int:
+    """An integer in [low, high]: a Python or numpy integer (a bool, a float or a string is refused:
+    YADE's converter takes a bool for an integer, PFV does not)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {value!r}")
+    value = int(value)
+    if not low <= value <= high:
+        raise ValueError(f"{name} must be in [{low}, {high}], got {value}")
+    return value
+
+
 def as_index(name: str, value: Any) -> int:
-    """An integer index (a bool or a float is refused, as YADE's converters refuse them)."""
-    if isinstance(value, (bool, float)) or not isinstance(value, numbers.Integral):
+    """An integer index: a Python or numpy integer (a bool or a float is refused)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name} must be an integer, got {value!r}")
     return int(value)
 

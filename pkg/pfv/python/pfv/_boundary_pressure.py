@@ -11,6 +11,7 @@ never rebuilds the system. Without a load nothing here runs during a step.
 from __future__ import annotations
 
 import math
+import numbers
 import weakref
 from collections.abc import Sequence
 from typing import Any, Callable
@@ -21,6 +22,24 @@ from . import _attributes as attributes
 
 WALL_NAMES = ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax")
 _YADE_WAVE_WALL = 3  # YADE's waveAction loads ymax and its profile lies on ymax
+
+
+def _real_values(name: str, p: Any) -> np.ndarray:
+    """What a pressure function returned, as floats: real numbers only (Python or numpy ints and floats,
+    or an array of them). A string, None, a bool, a complex number or an array of those raises
+    TypeError, where numpy would read "5.0" as 5, True as 1, None as NaN or drop an imaginary part."""
+    refused = TypeError(
+        f"{name}: the pressure function must return numbers (real: no strings, bools, None or complex), got {p!r:.80}"
+    )
+    if isinstance(p, (str, bytes, bool, np.bool_)) or p is None:
+        raise refused
+    try:
+        values = np.asarray(p)
+    except (TypeError, ValueError):  # ragged sequences
+        raise refused from None
+    if values.dtype.kind not in "iuf":
+        raise refused
+    return values.astype(float)
 
 
 class BoundaryPressure:
@@ -118,8 +137,9 @@ class BoundaryPressure:
         of their shape, or a number); these replace bndCondValue[wall] in the right-hand side only (no new
         system). pfv.waves has the thesis' profiles. It must not call the engine (that raises RuntimeError).
         One load per engine: this replaces the previous one."""
-        if isinstance(wall, bool) or not isinstance(wall, int):
+        if isinstance(wall, (bool, np.bool_)) or not isinstance(wall, numbers.Integral):
             raise TypeError(f"set_boundary_pressure wall must be a wall index 0..5 (e.g. flow.ymax), got {wall!r}")
+        wall = int(wall)
         if not 0 <= wall < 6:
             raise ValueError(f"set_boundary_pressure wall must be in 0..5, got {wall}")
         if not callable(pressure):
@@ -175,12 +195,7 @@ class BoundaryPressure:
         name = "waveAction" if self._wave_action else f"set_boundary_pressure({WALL_NAMES[wall]})"
         n = len(positions)
         p = function(positions[:, 0], positions[:, 1], positions[:, 2], self._time)
-        try:
-            if p is None:  # numpy would take it for NaN
-                raise TypeError
-            p = np.asarray(p, dtype=float)
-        except (TypeError, ValueError):
-            raise TypeError(f"{name}: the pressure function must return numbers, got {p!r:.80}") from None
+        p = _real_values(name, p)
         if p.ndim == 0:
             p = np.full(n, float(p))
         elif p.shape != (n,):

@@ -38,7 +38,8 @@ class CellConditions:
 
     def setImposedPressure(self, cond: int, p: float) -> None:
         """Change the pressure of the imposed condition number cond."""
-        self._core.set_imposed_pressure(int(cond), attributes.as_number("setImposedPressure pressure", p))
+        cond = attributes.as_index("setImposedPressure cond", cond)
+        self._core.set_imposed_pressure(cond, attributes.as_number("setImposedPressure pressure", p))
 
     def clearImposedPressure(self) -> None:
         self._core.clear_imposed_pressure()

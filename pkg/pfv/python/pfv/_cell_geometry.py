@@ -79,7 +79,7 @@ class CellGeometry:
         return self._core.locate(attributes.as_point("getCell position", (X, Y, Z)))
 
     def getCellCenter(self, id: int) -> Vector3:
-        return Vector3(*self._core.cell_center(int(id)))
+        return Vector3(*self._core.cell_center(attributes.as_index("getCellCenter id", id)))
 
     def getCellVolume(self, pos: Sequence[float]) -> float:
         return self._core.cell_volume(self.cell_at(pos))

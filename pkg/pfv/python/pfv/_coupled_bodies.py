@@ -85,7 +85,7 @@ class CoupledBodies:
 
     @mask.setter
     def mask(self, value: int) -> None:
-        self._mask = attributes.as_index("mask", value)
+        self._mask = attributes.as_integer("mask", value, low=-(2**63), high=2**63 - 1)  # YADE's mask is a long
         self._bodies_changed()
 
     @property
@@ -110,7 +110,7 @@ class CoupledBodies:
 
     @idOffset.setter
     def idOffset(self, value: int) -> None:
-        self._id_offset = attributes.as_index("idOffset", value)
+        self._id_offset = attributes.as_integer("idOffset", value)
         if self._id_offset < 0:
             self._bodies_changed()
 
@@ -202,7 +202,7 @@ class CoupledBodies:
     def vertex_of(self, body_id: int) -> int:
         """The core's vertex of a body (a sphere, or a wall by its wallIds entry) of the current mesh."""
         self.require_mesh()
-        v = self.stepped.vertex_of_id.get(int(body_id))
+        v = self.stepped.vertex_of_id.get(attributes.as_index("body id", body_id))
         if v is None:
             raise ValueError(f"body {body_id} is not coupled with the fluid (not a sphere nor a wall)")
         return v

@@ -35,7 +35,7 @@ class FlowQueries:
         return self._core.cell_pressure(self._geometry.cell_at(pos))
 
     def getCellPressure(self, id: int) -> float:
-        return self._core.cell_pressure(int(id))
+        return self._core.cell_pressure(attributes.as_index("getCellPressure id", id))
 
     def averagePressure(self) -> float:
         self._bodies.require_mesh()
@@ -43,7 +43,8 @@ class FlowQueries:
 
     def averageSlicePressure(self, posY: float, axis: int = 1) -> float:
         self._bodies.require_mesh()
-        return self._core.average_slice_pressure(int(axis), attributes.as_number("averageSlicePressure position", posY))
+        axis = attributes.as_index("averageSlicePressure axis", axis)
+        return self._core.average_slice_pressure(axis, attributes.as_number("averageSlicePressure position", posY))
 
     def absolute_pressure(self, pos: Sequence[float]) -> float:
         """The pore pressure at pos with its hydrostatic part: getPorePressure(pos) + fluid_density g.(pos - top),
@@ -75,11 +76,7 @@ class FlowQueries:
         return self._core.cell_flux(cell)
 
     def getBoundaryFlux(self, boundary: int) -> float:
-        self._bodies.require_mesh()
-        wall_ids = self._bodies.stepped.wall_ids  # those of the last step, if wallIds changed since
-        if boundary not in wall_ids:
-            raise ValueError(f"body {boundary} is not one of the boundaries wallIds = {wall_ids}")
-        return self._core.boundary_flux(wall_ids.index(boundary))
+        return self._core.boundary_flux(self._bodies.wall_index(boundary))  # the wallIds of the last step
 
     def _boundary_throats(self, boundary: Any) -> tuple[np.ndarray, np.ndarray]:
         """The cells touching the wall `boundary` (a body id) and their throats (cell, local) to cells that

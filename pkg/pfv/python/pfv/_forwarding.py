@@ -37,12 +37,11 @@ def setting(part: str, member: property) -> property:
             return member.fget(getattr(engine, part))
 
     def set_(engine, value):
-        if member.fset is None:
-            raise AttributeError(f"{member.fget.__name__} is read-only (computed by the engine)")
         with engine._lock:
             member.fset(getattr(engine, part), value)
 
-    return property(get, set_, doc=member.__doc__)
+    # A read-only member stays read-only (no setter): the engine's attribute surface tells them apart.
+    return property(get, set_ if member.fset is not None else None, doc=member.__doc__)
 
 
 def method(part: str, function: Callable[..., Any], locked: bool = True) -> Callable[..., Any]:

@@ -7,16 +7,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
 from yade.minieigenHP import Vector3
 
 from . import _attributes as attributes
 
 
 def _thread_count(name: str, value: Any) -> int:
-    value = attributes.as_index(name, value)
-    if value < 1:
-        raise ValueError(f"{name} must be at least 1, got {value}")
-    return value
+    return attributes.as_integer(name, value, low=1)
 
 
 class KeptSettings:
@@ -66,7 +64,9 @@ class KeptSettings:
 
     @boundaryVelocity.setter
     def boundaryVelocity(self, value: Sequence[Any]) -> None:
-        if isinstance(value, (str, bytes)) or len(value) != 6:
+        if isinstance(value, (str, bytes)) or not isinstance(value, Sequence | np.ndarray):
+            raise TypeError(f"boundaryVelocity must be a sequence of 6 vectors, got {value!r}")
+        if len(value) != 6:
             raise ValueError("boundaryVelocity needs 6 vectors (xmin, xmax, ymin, ymax, zmin, zmax)")
         self._boundary_velocity = tuple(attributes.as_point(f"boundaryVelocity[{w}]", v) for w, v in enumerate(value))
 
@@ -77,7 +77,9 @@ class KeptSettings:
 
     @ids.setter
     def ids(self, value: Sequence[int]) -> None:
-        self._ids = tuple(attributes.as_index("ids entry", v) for v in value)
+        if isinstance(value, (str, bytes)) or not isinstance(value, Sequence | np.ndarray):
+            raise TypeError(f"ids must be a sequence of body ids, got {value!r}")
+        self._ids = tuple(attributes.as_index(f"ids[{i}]", v) for i, v in enumerate(value))
 
     @property
     def volumeFactor(self) -> float:

@@ -8,10 +8,11 @@ engine's attributes time_step_safety, strict_time_step, collective_iterations(_w
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Callable
 
 import yade
 
+from . import _attributes as attributes
 from ._coupled_bodies import CoupledBodies
 from ._scene_scan import SceneScan
 from ._time_step import TimeStepGuard, viscous_time_step
@@ -20,11 +21,18 @@ from ._time_step import TimeStepGuard, viscous_time_step
 _SAVED_GUARD_SETTINGS = ("safety", "strict", "iterations", "iterations_warm")
 
 
-def _guard_setting(name: str, doc: str) -> property:
-    """A property that reads and writes the TimeStepGuard's attribute `name`."""
+def _guard_setting(name: str, attribute: str, convert: Callable[[str, Any], Any], doc: str) -> property:
+    """A property that reads and writes the TimeStepGuard's attribute `name`, checked by `convert` under
+    the engine's name `attribute` of it."""
     return property(
-        lambda self: getattr(self.guard, name), lambda self, value: setattr(self.guard, name, value), doc=doc
+        lambda self: getattr(self.guard, name),
+        lambda self, value: setattr(self.guard, name, convert(attribute, value)),
+        doc=doc,
     )
+
+
+def _iterations(name: str, value: Any) -> int:
+    return attributes.as_integer(name, value, low=1)
 
 
 class TimeStepLimits:
@@ -36,16 +44,28 @@ class TimeStepLimits:
         self.guard = TimeStepGuard()
 
     time_step_safety = _guard_setting(
-        "safety", "O.dt must stay below time_step_safety * critical_time_step (zeta of thesis 4.22); 0.8."
+        "safety",
+        "time_step_safety",
+        attributes.as_positive,
+        "O.dt must stay below time_step_safety * critical_time_step (zeta of thesis 4.22); 0.8 (positive).",
     )
     strict_time_step = _guard_setting(
-        "strict", "True: an unsafe O.dt raises ValueError instead of warning (TimeStepWarning)."
+        "strict",
+        "strict_time_step",
+        attributes.as_flag,
+        "True: an unsafe O.dt raises ValueError instead of warning (TimeStepWarning).",
     )
     collective_iterations = _guard_setting(
-        "iterations", "Operator applications at most for the collective limit of the first mesh (cold start); 40."
+        "iterations",
+        "collective_iterations",
+        _iterations,
+        "Operator applications at most for the collective limit of the first mesh (cold start); 40 (at least 1).",
     )
     collective_iterations_warm = _guard_setting(
-        "iterations_warm", "Operator applications at most for the collective limit of a later mesh (warm start); 10."
+        "iterations_warm",
+        "collective_iterations_warm",
+        _iterations,
+        "Operator applications at most for the collective limit of a later mesh (warm start); 10 (at least 1).",
     )
 
     @property

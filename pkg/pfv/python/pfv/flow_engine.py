@@ -19,7 +19,6 @@ and the file outputs (``_file_outputs``). The attribute surface's rules are in `
 """
 from __future__ import annotations
 
-import numbers
 import threading
 import warnings
 from collections.abc import Sequence
@@ -36,7 +35,8 @@ from . import _registry as registry
 from ._boundary_pressure import BoundaryPressure
 from ._cell_conditions import CellConditions
 from ._cell_geometry import CellGeometry
-from ._core import Engine, set_num_threads
+from ._core import set_num_threads
+from ._engine import Engine
 from ._coupled_bodies import CoupledBodies
 from ._file_outputs import FileOutputs
 from ._flow_queries import FlowQueries
@@ -167,15 +167,34 @@ class FlowEngine(PyRunner):
             value = attributes.as_setting(name, value, getattr(self._core, core_name))
             with self._lock:
                 try:
-                    setattr(self._core, core_name, value)
-                except ValueError as error:
-                    raise ValueError(f"pfv.FlowEngine.{name}: {error}") from None
+                    self._core.assign(core_name, value)
+                except (TypeError, ValueError) as error:
+                    raise type(error)(f"pfv.FlowEngine.{name}: {error}") from None
+        elif name in _RUNNER_ATTRIBUTES:
+            self._set_runner_attribute(name, value)
         elif name in _FIELDS or name in _OWN_ATTRIBUTES:
+            member = getattr(type(self), name, None)
+            if isinstance(member, property) and member.fset is None:
+                raise AttributeError(f"{name} is read-only (computed by the engine)")
             object.__setattr__(self, name, value)
         elif attributes.is_yade_attribute(name):
             attributes.check_default(name, value)
         else:
             raise attributes.unknown_attribute(name, setting=True)
+
+    def _set_runner_attribute(self, name: str, value: Any) -> None:
+        """An attribute of YADE's PyRunner: YADE's converter checks it; its refusal names the attribute
+        here. The command drives this engine (and its saved state): it is the engine's own."""
+        current = getattr(self, name)
+        if name == "command" and current and isinstance(value, str) and value != current:
+            raise ValueError("command drives this pfv.FlowEngine and cannot be changed (create a PyRunner instead)")
+        try:
+            object.__setattr__(self, name, value)
+        except TypeError:  # Boost.Python's ArgumentError, which names neither
+            raise TypeError(
+                f"pfv.FlowEngine.{name} (YADE's PyRunner attribute) must be a {type(current).__name__}, "
+                f"got {value!r}"
+            ) from None
 
     def __getattr__(self, name: str) -> Any:  # only called when normal lookup fails
         if name in attributes.CORE_NAME:
@@ -220,7 +239,7 @@ class FlowEngine(PyRunner):
 
     @updateTriangulation.setter
     def updateTriangulation(self, value: bool) -> None:
-        if value:
+        if attributes.as_flag("updateTriangulation", value):
             self._core.request_remesh()
 
     @property
@@ -230,11 +249,10 @@ class FlowEngine(PyRunner):
 
     @ompThreads.setter
     def ompThreads(self, value: int) -> None:
-        if not isinstance(value, numbers.Integral) or isinstance(value, bool):
-            raise TypeError(f"ompThreads must be an integer, got {value!r}")
+        value = attributes.as_integer("ompThreads", value)
         if value > _MAX_THREADS:
             raise ValueError(f"ompThreads = {value} is more than {_MAX_THREADS} threads")
-        self._threads = int(value) if value > 0 else None
+        self._threads = value if value > 0 else None
 
     # -- the coupled bodies (_coupled_bodies) -----------------------------------------------
     boundaryUseMaxMin = setting("_bodies", CoupledBodies.boundaryUseMaxMin)
@@ -531,5 +549,12 @@ class FlowEngine(PyRunner):
 _OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) | {
     name for klass in FlowEngine.__mro__ for name, v in vars(klass).items() if isinstance(v, property)
 }
+# YADE's PyRunner attributes, checked by YADE's converters: all but FlowEngine's own properties
+# (ompThreads, timingDeltas).
+_RUNNER_ATTRIBUTES = frozenset(
+    a
+    for a in dir(PyRunner)
+    if not a.startswith("_") and not callable(getattr(PyRunner, a)) and a not in vars(FlowEngine)
+)
 
 _persistence.install()  # O.save / O.load carry the engines' state

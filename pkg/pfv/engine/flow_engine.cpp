@@ -285,13 +285,15 @@ void FlowEngine::compute_forces(const std::vector<Vec3>& centres, const std::vec
   force_loop_.done(seconds_since(t0));
   if (settings.fluid_density > 0) {
     const Vec3 weight = settings.fluid_density * (4.0 / 3.0) * std::numbers::pi * settings.gravity;
-    for (std::size_t k = 0; k < radii.size(); ++k) next_force_[k] -= radii[k] * radii[k] * radii[k] * weight;
-    // Named here, where the cause is known: the settings, not a force of unknown origin below.
-    for (std::size_t k = 0; k < radii.size(); ++k)
-      if (!(radii[k] * radii[k] * radii[k] * weight).allFinite())
+    for (std::size_t k = 0; k < radii.size(); ++k) {
+      const Vec3 buoyancy = radii[k] * radii[k] * radii[k] * weight;
+      // Named here, where the cause is known: the settings, not a force of unknown origin below.
+      if (!buoyancy.allFinite())
         throw std::domain_error("the buoyancy of sphere " + std::to_string(k) +
                                 ", fluid_density x its volume x gravity, is not finite (fluid_density = " +
                                 describe(settings.fluid_density) + ", gravity = " + describe(settings.gravity) + ")");
+      next_force_[k] -= buoyancy;
+    }
   }
   step_times_.forces = seconds_since(t0);
 

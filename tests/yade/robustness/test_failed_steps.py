@@ -188,6 +188,7 @@ def case(name, fault, kind, background, expected):
     fault(flow, True)
     failed = False
     for attempt in range(ATTEMPTS):
+        flow.core.wait_for_remesh()  # a background remesh in flight is adopted by the next step
         before = state(flow)
         try:
             O.run(1, True)

@@ -1,6 +1,7 @@
 #include "pfv/linalg/refinement.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "pfv/common/parallel.hpp"
@@ -18,11 +19,11 @@ double max_abs(const std::vector<double>& v) {
 // r = b - G x from G's rows; W > 0 fixes the width at compile time.
 template <int W>
 void residual_by_rows(const MatrixRows& s, const std::vector<double>& b, const std::vector<double>& x,
-                      std::vector<double>& r) {
+                      std::vector<double>& r, bool team) {
   const int n = static_cast<int>(s.diagonal.size());
   const int w = W > 0 ? W : s.width;
   r.resize(n);
-#pragma omp parallel for schedule(static) if (n > kMinParallelLoop)
+#pragma omp parallel for schedule(static) if (team && n > kMinParallelLoop)
   for (int u = 0; u < n; ++u) {
     const int* column = s.column.data() + static_cast<std::size_t>(u) * w;
     const double* value = s.value.data() + static_cast<std::size_t>(u) * w;
@@ -35,13 +36,16 @@ void residual_by_rows(const MatrixRows& s, const std::vector<double>& b, const s
 }  // namespace
 
 void residual(const SymmetricMatrix& s, const MatrixRows& rows, const std::vector<double>& b,
-              const std::vector<double>& x, std::vector<double>& r) {
+              const std::vector<double>& x, std::vector<double>& r, LoopChoice* choice) {
   const int n = s.size();
   if (static_cast<int>(rows.diagonal.size()) == n && n > 0) {
+    const bool team = choice ? choice->team(n) : true;
+    const auto start = std::chrono::steady_clock::now();
     if (rows.width == 4)
-      residual_by_rows<4>(rows, b, x, r);
+      residual_by_rows<4>(rows, b, x, r, team);
     else
-      residual_by_rows<0>(rows, b, x, r);
+      residual_by_rows<0>(rows, b, x, r, team);
+    if (choice) choice->done(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     return;
   }
   r.assign(b.begin(), b.end());
@@ -69,7 +73,7 @@ double Refinement::estimate_contraction(const SymmetricMatrix& s, const MatrixRo
   double norm = max_abs(v), ratio = 0;
   for (int it = 0; it < kPowerIterations; ++it) {
     for (double& x : v) x /= norm;
-    residual(s, rows, zero, v, residual_);  // -G v
+    residual(s, rows, zero, v, residual_, &residual_loop_);  // -G v
     m.solve(residual_, gv);                 // -M^-1 G v
     for (int i = 0; i < n; ++i) v[i] += gv[i];
     const double next = max_abs(v);
@@ -89,7 +93,7 @@ bool Refinement::solve(const SymmetricMatrix& s, const MatrixRows& rows, Cholmod
   double previous = 0;
   passes_ = 0;
   while (passes_ < max_passes) {
-    residual(s, rows, b, x, residual_);
+    residual(s, rows, b, x, residual_, &residual_loop_);
     m.solve(residual_, correction_);
     for (std::size_t i = 0; i < x.size(); ++i) x[i] += correction_[i];
     ++passes_;

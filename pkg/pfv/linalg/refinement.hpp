@@ -16,6 +16,7 @@
 #pragma once
 #include <vector>
 
+#include "pfv/common/parallel.hpp"
 #include "pfv/linalg/matrix_rows.hpp"
 #include "pfv/linalg/symmetric_matrix.hpp"
 
@@ -49,12 +50,14 @@ class Refinement {
   double estimate_contraction(const SymmetricMatrix& g, const MatrixRows& rows, CholmodSolver& factor);
 
   std::vector<double> residual_, correction_;
+  LoopChoice residual_loop_;  // one thread or the team for the residual, by measured time
   double rho_ = -1, seed_ = -1;
   int passes_ = 0;
 };
 
-// r = b - G x: from G's rows unless rows is empty, else from its upper triangle by column.
+// r = b - G x: from G's rows unless rows is empty, else from its upper triangle by column. By
+// rows on the OpenMP team above kMinParallelLoop rows, or as `choice` measures (the same bits).
 void residual(const SymmetricMatrix& g, const MatrixRows& rows, const std::vector<double>& b,
-              const std::vector<double>& x, std::vector<double>& r);
+              const std::vector<double>& x, std::vector<double>& r, LoopChoice* choice = nullptr);
 
 }  // namespace pfv

@@ -1,29 +1,39 @@
 """O.save / O.load of a scene with a pfv.FlowEngine: the engine goes on where it stopped.
 
-YADE saves a ``PyRunner`` subclass as a plain ``PyRunner`` (its command and label, nothing of the
-Python object), and restores it so. PFV therefore wraps YADE's ``save``/``saveTmp`` and
-``load``/``loadTmp``/``reload``: before a save, each pfv engine in ``O.engines`` writes its
-settings and its run state (the positions its mesh was built from, the positions and pressures
-of its last step, the remesh schedule) into a tag of the scene, ``O.tags["pfv.saved.<i>"]``
-for the engine at ``O.engines[i]``; after a load, every plain ``PyRunner`` with PFV's command
-and such a tag is replaced by a new ``pfv.FlowEngine`` rebuilt from it (which rebuilds the
-same mesh: the triangulation is a function of its input), and YADE binds its label again. The
-next step then equals the uninterrupted run's. A tag is emptied once used; arrays travel as
-base64 of their float64 bytes, bit for bit.
+YADE saves a ``PyRunner`` subclass as a plain ``PyRunner`` (its command, label and schedule, nothing
+of the Python object), and restores it so. PFV therefore wraps YADE's ``save``/``saveTmp``/
+``sceneToString`` and ``load``/``loadTmp``/``reload``/``stringToScene``: before a save, each pfv
+engine in ``O.engines`` writes its settings and its run state (the positions its mesh was built
+from, the positions and pressures of its last step, the remesh schedule) into a tag of the scene,
+``O.tags["pfv.saved.<i>"]`` for the engine at ``O.engines[i]``; after a load, every plain
+``PyRunner`` with PFV's command and such a tag is replaced by a new ``pfv.FlowEngine`` rebuilt from
+it (which rebuilds the same mesh: the triangulation is a function of its input), and its label is
+bound to it. The next step then equals the uninterrupted run's. A tag is emptied once used; arrays
+travel as base64 of their float64 bytes, bit for bit.
+
+A scene loaded where the wrappers did not see it (a process that imports pfv after the load, or
+never: the PyRunner's command imports it at the first step) is taken over when pfv is imported.
+Until then YADE's label names the plain PyRunner: attributes a script sets on it are kept in its
+dictionary and applied to the engine when it takes over.
 """
 from __future__ import annotations
 
 import base64
 import builtins
 import json
+import warnings
+import weakref
 from typing import Any
 
 import numpy as np
 
 import yade
-from yade.wrapper import Omega, PyRunner
+from yade.wrapper import PyRunner
+
+from . import _lifecycle
 
 TAG = "pfv.saved."  # + index in O.engines
+_adopted = weakref.WeakValueDictionary()  # command of a restored PyRunner -> the engine in its place
 
 
 def _encode(value: Any) -> Any:
@@ -67,70 +77,100 @@ def _before_save() -> None:
             tags[TAG + str(i)] = json.dumps(_encode(engine._saved_state()))
 
 
-def _after_load() -> None:
+def _restored_runners(engines: list[Any]) -> list[tuple[int, PyRunner, str]]:
+    """(index, runner, saved state) of the plain PyRunners of `engines` that stand for a pfv engine."""
     cls = _flow_engine_class()
-    engines = list(yade.O.engines)
-    restored = False
+    found = []
     for i, runner in enumerate(engines):
+        if type(runner) is not PyRunner or not cls.drives(runner.command):
+            continue
         try:
             text = yade.O.tags[TAG + str(i)]
         except KeyError:
             continue
-        if not text or type(runner) is not PyRunner or not cls.drives(runner.command):
-            continue
-        engines[i] = cls._from_saved(_decode(json.loads(text)), runner)
-        yade.O.tags[TAG + str(i)] = ""
-        restored = True
-    if restored:
-        yade.O.engines = engines  # YADE binds the labels to the new objects
+        if text:
+            found.append((i, runner, text))
+    return found
 
 
-def adopt_runner(command: str):
-    """The engine rebuilt for the restored PyRunner that runs `command`, put in its place in
-    O.engines from the next iteration on (this one is under way), or None without a saved state."""
-    cls = _flow_engine_class()
+def _settings_of_label(runner: PyRunner) -> dict[str, Any]:
+    """What a script set on the runner's label before pfv took it over: YADE binds the label to a plain
+    PyRunner, which keeps any attribute in its own dictionary, where no engine would read it."""
+    bound = getattr(builtins, runner.label, None) if runner.label else None
+    if type(bound) is not PyRunner or bound.command != runner.command:
+        return {}
+    return dict(vars(bound))
+
+
+def _rebuilt(state: dict[str, Any], runner: PyRunner) -> Any:
+    """The engine for `runner`, with the settings made on its label before pfv took it over."""
+    engine = _flow_engine_class()._from_saved(state, runner)
+    for name, value in _settings_of_label(runner).items():
+        try:
+            setattr(engine, name, value)
+        except Exception as error:
+            raise type(error)(
+                f"pfv.FlowEngine '{runner.label}': {name} = {value!r}, set on the plain PyRunner YADE restored "
+                f"before pfv was imported, is refused: {error} (import pfv before O.load)"
+            ) from None
+    return engine
+
+
+def adopt_restored() -> None:
+    """Put a pfv.FlowEngine rebuilt from its saved state in place of every plain PyRunner that stands for
+    one, and bind the labels to them. Each engine is built before any is put in place: a setting refused
+    leaves the scene as it was."""
     engines = list(yade.O.engines)
-    for i, runner in enumerate(engines):
-        if type(runner) is PyRunner and runner.command == command:
-            try:
-                text = yade.O.tags[TAG + str(i)]
-            except KeyError:
-                return None
-            if not text:
-                return None
-            engines[i] = cls._from_saved(_decode(json.loads(text)), runner)
-            yade.O.tags[TAG + str(i)] = ""
-            # Taken up at the next iteration; YADE binds labels then, the script may look before.
-            yade.O.engines = engines
-            if runner.label:
-                setattr(builtins, runner.label, engines[i])
-            return engines[i]
-    return None
-
-
-def _wrap(method_name: str, before=None, after=None) -> None:
-    original = getattr(Omega, method_name)
-    if getattr(original, "_pfv_wrapped", False):
+    restored = _restored_runners(engines)
+    rebuilt = [(i, runner, _rebuilt(_decode(json.loads(text)), runner)) for i, runner, text in restored]
+    if not rebuilt:
         return
+    for i, _, engine in rebuilt:
+        engines[i] = engine
+    # Between iterations YADE puts the list in place and binds the labels; in the middle of one (a scene
+    # saved while O.run() ran, or a load from within a step) it keeps the list for the next iteration and
+    # binds the labels to the engines of the iteration under way: the plain runners.
+    yade.O.engines = engines
+    for i, runner, engine in rebuilt:
+        yade.O.tags[TAG + str(i)] = ""
+        _adopted[runner.command] = engine
+        if runner.label:
+            setattr(builtins, runner.label, engine)
 
-    def wrapped(self, *args, **kwargs):
-        if before is not None:
-            before()
-        result = original(self, *args, **kwargs)
-        if after is not None:
-            after()
-        return result
 
-    wrapped._pfv_wrapped = True
-    wrapped.__wrapped__ = original  # YADE's own method
-    wrapped.__doc__ = original.__doc__
-    setattr(Omega, method_name, wrapped)
+def engine_for(command: str) -> Any:
+    """The pfv.FlowEngine that stands for the plain PyRunner running `command` (all of the scene's taken
+    over now), or None without a saved state."""
+    adopt_restored()
+    engine = _adopted.get(command)
+    if engine is None or not any(e is engine for e in yade.O.engines):
+        return None
+    return engine
+
+
+def _adopt_at_import() -> None:
+    """A scene loaded before pfv was imported (``yade scene.yade.gz``, O.load in a script that imports pfv
+    later): its engines are taken over now."""
+    try:
+        adopt_restored()
+    except Exception as error:  # the first step raises it again, naming the setting
+        warnings.warn(f"pfv: the engines of the loaded scene are not taken over yet: {error}", stacklevel=3)
+
+
+def _before_load() -> list[Any]:
+    return _lifecycle.engines_of_this_scene()
+
+
+def _after_load(ended: list[Any]) -> None:
+    _lifecycle.release(ended)
+    adopt_restored()
 
 
 def install() -> None:
-    """Wrap YADE's save and load methods (once per process)."""
-    for name in ("save", "saveTmp"):
-        _wrap(name, before=_before_save)
-    for name in ("load", "loadTmp", "reload", "reloadTmp"):
-        if hasattr(Omega, name):
-            _wrap(name, after=_after_load)
+    """Wrap YADE's save and load methods (once per process), and take over a scene loaded before."""
+    _lifecycle.install()
+    for name in ("save", "saveTmp", "sceneToString"):
+        _lifecycle.wrap(name, before=_before_save)
+    for name in ("load", "loadTmp", "reload", "stringToScene"):
+        _lifecycle.wrap(name, before=_before_load, after=_after_load)
+    _adopt_at_import()

@@ -3,7 +3,8 @@ engines hold a mesh.
 
 YADE keeps a reference to every engine ever put into O.engines, so an engine taken out is never
 freed: the step of an engine in use frees the mesh of those no longer in their scene
-(``release_unused``).
+(``release_unused``), and the calls that end a scene free the meshes of its engines
+(``holding``, ``_lifecycle``).
 """
 from __future__ import annotations
 
@@ -33,6 +34,18 @@ def hold(engine: Any) -> None:
 def drop(engine: Any) -> None:
     """`engine` holds no mesh any more."""
     _holding.discard(engine._key)
+
+
+def holding(scene: Any) -> list[Any]:
+    """The engines that hold a mesh and last ran in `scene` (every scene: None)."""
+    engines = []
+    for key in list(_holding):
+        engine = _engines.get(key)
+        if engine is None:
+            _holding.discard(key)
+        elif scene is None or engine._ran_in(scene):
+            engines.append(engine)
+    return engines
 
 
 def release_unused(current: Any) -> None:

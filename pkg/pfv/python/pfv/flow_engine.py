@@ -19,6 +19,7 @@ and the file outputs (``_file_outputs``). The attribute surface's rules are in `
 """
 from __future__ import annotations
 
+import secrets
 import threading
 import warnings
 from collections.abc import Sequence
@@ -62,9 +63,10 @@ def _run(key: int) -> None:
     engine = registry.get(key)
     # After a load the running PyRunner is a restored copy, not this engine (which may still be
     # alive in this process): driving the old object would be silently wrong. A scene loaded
-    # by O.load is adopted at the load; one loaded otherwise (yade file.yade.gz) is adopted here.
+    # by O.load is adopted at the load or when pfv is imported; in the iteration under way when
+    # it was adopted, YADE still runs the restored copies, which drive the adopted engines.
     if engine is None or not any(e is engine for e in yade.O.engines):
-        engine = _persistence.adopt_runner(_COMMAND.format(key))
+        engine = _persistence.engine_for(_COMMAND.format(key))
         if engine is None:
             raise RuntimeError(
                 "this pfv.FlowEngine must be re-created: YADE restored it as a plain PyRunner and the "
@@ -92,6 +94,23 @@ _SAVED_CORE_SETTINGS = ("max_k_div_k_mean",) + tuple(
         )
         - {"max_k_div_k_mean"}
     )
+)
+
+# What YADE saves of a PyRunner besides its command and label: when it runs.
+_RUNNER_SCHEDULE = (
+    "iterPeriod",
+    "virtPeriod",
+    "realPeriod",
+    "nDo",
+    "initRun",
+    "firstIterRun",
+    "iterLast",
+    "virtLast",
+    "realLast",
+    "nDone",
+    "dead",
+    "ignoreErrors",
+    "updateGlobals",
 )
 
 # The engine's own fields (plain instance attributes, not YADE attributes): the core, the engine's
@@ -137,7 +156,7 @@ class FlowEngine(PyRunner):
     def __init__(self, **kwargs: Any) -> None:
         PyRunner.__init__(self)
         self._core = core = Engine()
-        self._key = id(self)
+        self._key = secrets.randbits(62)  # unlike id(), never that of an engine saved by another process
         self._lock = threading.RLock()  # held by a step and by every query (O.run steps on its own thread)
         self._timings = StageTimings()
         self._threads = None  # ompThreads, None: follow YADE's -j
@@ -468,6 +487,10 @@ class FlowEngine(PyRunner):
         self._history.last_step = None
         registry.drop(self)
 
+    def _ran_in(self, scene: Any) -> bool:
+        """Whether this engine last ran in `scene`."""
+        return self._history.in_scene(scene)
+
     def _release_if_gone(self, scene: Any, engines: Sequence[Any]) -> None:
         """_release() if this engine ran in `scene` but is no longer among its `engines`."""
         if self._history.in_scene(scene) and not any(e is self for e in engines):
@@ -521,8 +544,8 @@ class FlowEngine(PyRunner):
         engine._threads = state["threads"]
         for key, part in _SAVED_PARTS.items():
             getattr(engine, part).restore(state[key])
-        for name, value in state["runner"].items():
-            setattr(engine, name, value)
+        for name in _RUNNER_SCHEDULE:  # YADE restores them (a script may have changed them since the load)
+            setattr(engine, name, getattr(runner, name))
         engine.label = runner.label
         if state["run"] is not None:
             engine._resume(state["run"], state["last_step"])

@@ -21,6 +21,7 @@ from __future__ import annotations
 import base64
 import builtins
 import json
+import threading
 import warnings
 import weakref
 from typing import Any
@@ -64,6 +65,17 @@ def _flow_engine_class() -> type:
     from .flow_engine import FlowEngine  # circular at import time: flow_engine installs this module
 
     return FlowEngine
+
+
+def _due_again(runner: PyRunner) -> int | None:
+    """A scene saved in the middle of an iteration (while O.run() runs) is loaded with that iteration to
+    run again from its start. The fluid forces of the engine's run in it are not saved, so the engine must
+    run in it again: the iterLast that makes it due then, if YADE had started it in the iteration under
+    way (None if not, or if the scene is between iterations)."""
+    scene = yade.O
+    if scene.subStep < 0 or runner.iterPeriod <= 0 or runner.iterLast != scene.iter:
+        return None
+    return scene.iter - runner.iterPeriod
 
 
 def _before_save() -> None:
@@ -116,17 +128,20 @@ def _rebuilt(state: dict[str, Any], runner: PyRunner) -> Any:
     return engine
 
 
-def adopt_restored() -> None:
+def adopt_restored(loaded: bool = False) -> None:
     """Put a pfv.FlowEngine rebuilt from its saved state in place of every plain PyRunner that stands for
     one, and bind the labels to them. Each engine is built before any is put in place: a setting refused
-    leaves the scene as it was."""
+    leaves the scene as it was. `loaded`: the scene was loaded and has not run since (not from a step)."""
     engines = list(yade.O.engines)
     restored = _restored_runners(engines)
     rebuilt = [(i, runner, _rebuilt(_decode(json.loads(text)), runner)) for i, runner, text in restored]
     if not rebuilt:
         return
-    for i, _, engine in rebuilt:
+    for i, runner, engine in rebuilt:
         engines[i] = engine
+        last = _due_again(runner) if loaded else None
+        if last is not None:
+            engine.iterLast = last
     # Between iterations YADE puts the list in place and binds the labels; in the middle of one (a scene
     # saved while O.run() ran, or a load from within a step) it keeps the list for the next iteration and
     # binds the labels to the engines of the iteration under way: the plain runners.
@@ -152,7 +167,7 @@ def _adopt_at_import() -> None:
     """A scene loaded before pfv was imported (``yade scene.yade.gz``, O.load in a script that imports pfv
     later): its engines are taken over now."""
     try:
-        adopt_restored()
+        adopt_restored(loaded=threading.current_thread() is threading.main_thread())  # not from a step
     except Exception as error:  # the first step raises it again, naming the setting
         warnings.warn(f"pfv: the engines of the loaded scene are not taken over yet: {error}", stacklevel=3)
 
@@ -163,7 +178,7 @@ def _before_load() -> list[Any]:
 
 def _after_load(ended: list[Any]) -> None:
     _lifecycle.release(ended)
-    adopt_restored()
+    adopt_restored(loaded=True)
 
 
 def install() -> None:

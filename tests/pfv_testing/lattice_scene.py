@@ -140,3 +140,32 @@ def remove_flows():
 
     O.engines = [e for e in O.engines if "FlowEngine" not in type(e).__name__]
     gc.collect()
+
+
+def build_box(n, engines=1, plain=False):
+    """A new scene in the current one (not reset here) for the tests of scene ends: N spheres of the lattice, fixed,
+    between six walls, `engines` pfv engines with a pressure drop along y (all but the first decoupled), a plain
+    PyRunner if `plain`, and no collider. Bodies are appended one by one: YADE's O.bodies.append(list) keeps a
+    reference to every body, a leak of its own. Returns the pfv engines."""
+    from pfv import FlowEngine
+    from yade import O, utils
+    from yade.wrapper import ForceResetter, NewtonIntegrator, PyRunner
+
+    centres, radii = jittered_lattice(n, 1)
+    lo, hi = (centres - radii[:, None]).min(axis=0), (centres + radii[:, None]).max(axis=0)
+    for wall in utils.aabbWalls([tuple(lo), tuple(hi)], thickness=0):
+        O.bodies.append(wall)
+    for c, r in zip(centres, radii):
+        O.bodies.append(utils.sphere(tuple(c), float(r), fixed=True))
+    flows = []
+    for k in range(engines):
+        flow = FlowEngine(decoupleForces=k > 0)
+        flow.wallIds = [0, 1, 2, 3, 4, 5]
+        flow.bndCondIsPressure = [False, False, True, True, False, False]
+        flow.bndCondValue = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
+        flow.boundaryUseMaxMin = [False] * 6
+        flows.append(flow)
+    runners = [PyRunner(command="pass", iterPeriod=1)] if plain else []
+    O.engines = [ForceResetter()] + flows + runners + [NewtonIntegrator()]
+    O.dt = DT
+    return flows

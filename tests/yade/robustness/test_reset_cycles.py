@@ -15,46 +15,28 @@
    memory may grow per cycle by at most a tenth of what one engine of this scene holds (measured here: four engines
    stepped in one scene), over what the same cycles without the engine grow (YADE's own). On main every reset
    scene's engine stays (YADE keeps a reference to every engine put into O.engines): a whole footprint per cycle.
+4. The end of the process while O.run() runs (the script's end, after O.pause(), sys.exit), one or two engines
+   (pfv_testing/exit_child.py): YADE exits with 0. On main the run thread takes the GIL back inside a step while
+   Python finalizes, is ended on the spot and the C++ of the step cannot survive it: std::terminate, exit 134.
 """
 import faulthandler
 import gc
 import time
 import warnings
 
-from pfv import FlowEngine
-from pfv_testing import checks, memory
-from pfv_testing.lattice import jittered_lattice
-from yade import O, utils
-from yade.wrapper import ForceResetter, NewtonIntegrator, PyRunner
+import subprocess
+
+import pfv  # noqa: F401  (its wrappers of YADE's resets)
+from pfv_testing import checks, lattice_scene, memory, paths
+from yade import O
 
 warnings.simplefilter("ignore")
 WATCHDOG = 120.0  # seconds: the calls return in milliseconds, a deadlock never
 SPHERES = 300
-CENTRES, RADII = jittered_lattice(SPHERES, 1)
-LO = tuple((CENTRES - RADII[:, None]).min(axis=0))
-HI = tuple((CENTRES + RADII[:, None]).max(axis=0))
 
 
 def build(engines=1, plain=False):
-    """A new scene (the current one is not reset here): the lattice between six walls, `engines` pfv engines with
-    a pressure drop along y (all but the first decoupled), a plain PyRunner if `plain`. Bodies are appended one by
-    one: YADE's O.bodies.append(list) keeps a reference to every body, a leak of its own."""
-    for wall in utils.aabbWalls([LO, HI], thickness=0):
-        O.bodies.append(wall)
-    for c, r in zip(CENTRES, RADII):
-        O.bodies.append(utils.sphere(tuple(c), float(r), fixed=True))
-    flows = []
-    for k in range(engines):
-        flow = FlowEngine(decoupleForces=k > 0)
-        flow.wallIds = [0, 1, 2, 3, 4, 5]
-        flow.bndCondIsPressure = [False, False, True, True, False, False]
-        flow.bndCondValue = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
-        flow.boundaryUseMaxMin = [False] * 6
-        flows.append(flow)
-    runners = [PyRunner(command="pass", iterPeriod=1)] if plain else []
-    O.engines = [ForceResetter()] + flows + runners + [NewtonIntegrator()]
-    O.dt = 1e-5
-    return flows
+    return lattice_scene.build_box(SPHERES, engines, plain)
 
 
 def run_in_background(iterations=3):
@@ -85,11 +67,11 @@ def load_empty():
 
 
 ENDS = {
-    "O.reset()": O.reset,
+    "O.reset()": lambda: O.reset(),
     "O.pause(), O.reset()": pause_then_reset,
-    "O.resetThisScene()": O.resetThisScene,
-    "O.resetCurrentScene()": O.resetCurrentScene,
-    "O.resetAllScenes()": O.resetAllScenes,
+    "O.resetThisScene()": lambda: O.resetThisScene(),
+    "O.resetCurrentScene()": lambda: O.resetCurrentScene(),
+    "O.resetAllScenes()": lambda: O.resetAllScenes(),
     "O.loadTmp() of another scene": load_empty,
 }
 SCENES = {  # what runs: (pfv engines, a plain PyRunner)
@@ -176,11 +158,11 @@ def engine_footprint(engines=4):
 
 
 MEMORY_CASES = [  # (name, cycles, end, while running)
-    ("O.reset()", 200, O.reset, False),
+    ("O.reset()", 200, ENDS["O.reset()"], False),
     ("O.reset() while O.run() runs", 40, None, True),
-    ("O.resetThisScene()", 40, O.resetThisScene, False),
-    ("O.resetCurrentScene()", 40, O.resetCurrentScene, False),
-    ("O.resetAllScenes()", 40, O.resetAllScenes, False),
+    ("O.resetThisScene()", 40, ENDS["O.resetThisScene()"], False),
+    ("O.resetCurrentScene()", 40, ENDS["O.resetCurrentScene()"], False),
+    ("O.resetAllScenes()", 40, ENDS["O.resetAllScenes()"], False),
     ("O.loadTmp() of another scene", 40, load_empty, False),
 ]
 
@@ -189,10 +171,10 @@ def memory_cases(footprint):
     O.reset()
     O.saveTmp("empty")
     for _ in range(5):  # allocator warm-up: the first cycles fill caches and pools
-        cycle_growth(1, 1, O.reset)
-        cycle_growth(1, 0, O.reset)
+        cycle_growth(1, 1, ENDS["O.reset()"])
+        cycle_growth(1, 0, ENDS["O.reset()"])
     for name, cycles, end, running in MEMORY_CASES:
-        yade_only = cycle_growth(cycles, 0, end or O.reset, running)
+        yade_only = cycle_growth(cycles, 0, end or ENDS["O.reset()"], running)
         with_engine = cycle_growth(cycles, 1, end, running)
         checks.check(
             f"{cycles} cycles ended by {name}: the engines are freed",
@@ -203,9 +185,31 @@ def memory_cases(footprint):
     return len(MEMORY_CASES)
 
 
+def exit_cases():
+    """The script ends while O.run() runs: YADE exits with 0 (on main: std::terminate, exit 134)."""
+    cases = 0
+    for engines in (1, 2):
+        for how in ("end", "pause", "exit"):
+            out = subprocess.run(
+                ["yade-double", "-n", "-x", paths.tool("exit_child.py"), str(engines), how],
+                capture_output=True,
+                text=True,
+                timeout=WATCHDOG,
+            )
+            ran = "RUNNING" in out.stdout
+            checks.check(
+                f"the script ends ({how}) while O.run() runs with {engines} pfv engine(s): exit 0",
+                ran and out.returncode == 0,
+                f"(exit {out.returncode}{'' if ran else ', did not run: ' + out.stderr[-300:]})",
+            )
+            cases += 1
+    return cases
+
+
 footprint = engine_footprint()  # first: later, freed memory is reused and the growth measured is less
 count = hang_cases()
 count += scoping_cases()
 count += memory_cases(footprint)
+count += exit_cases()
 print(f"{count} cases")
 checks.report("reset cycles")

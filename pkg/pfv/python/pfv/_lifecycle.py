@@ -10,9 +10,15 @@ Two things go wrong in YADE without them:
 * YADE's converter of Python lists (``O.engines = [...]``) keeps a reference to every object of the list,
   so an engine that was ever in ``O.engines`` is never freed. The engines of an ended scene free their
   mesh, factor and results here (their settings stay: put into another scene, they start afresh).
+
+The end of the process is one more: a script that ends while ``O.run()`` runs leaves YADE's thread
+running while Python finalizes, and a thread that takes the GIL back then is ended on the spot, which
+the C++ of a step (that lets the GIL go while it computes) cannot survive (``std::terminate``). At
+exit, before Python finalizes, the run is paused, a step under way finishes, and no step starts.
 """
 from __future__ import annotations
 
+import atexit
 from typing import Any, Callable
 
 import yade
@@ -71,8 +77,29 @@ def _stop_then_list_all() -> list[Any]:
     return engines_of_all_scenes()
 
 
+_exiting = False
+
+
+def exiting() -> bool:
+    """Whether Python is about to finalize: a step must not start."""
+    return _exiting
+
+
+def _at_exit() -> None:
+    global _exiting
+    _exiting = True
+    if yade.O.running:
+        yade.O.pause()  # the thread ends after its iteration
+    for engine in registry.engines():
+        with engine._lock:  # a step under way finishes (the wait lets the GIL go)
+            pass
+
+
 def install() -> None:
-    """Wrap YADE's resets (once per process)."""
+    """Wrap YADE's resets (once per process), and pause the run at exit."""
+    if not getattr(install, "done", False):
+        atexit.register(_at_exit)
+        install.done = True
     wrap("reset", before=_stop_then_list_all, after=release)
     wrap("resetAllScenes", before=engines_of_all_scenes, after=release)
     for name in ("resetThisScene", "resetCurrentScene"):

@@ -26,6 +26,11 @@ def get(key: int) -> Any:
     return _engines.get(key)
 
 
+def engines() -> list[Any]:
+    """Every live engine."""
+    return list(_engines.values())
+
+
 def hold(engine: Any) -> None:
     """`engine` holds a mesh now."""
     _holding.add(engine._key)

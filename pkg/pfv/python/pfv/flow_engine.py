@@ -31,6 +31,7 @@ import yade
 from yade.wrapper import NewtonIntegrator, PyRunner
 
 from . import _attributes as attributes
+from . import _lifecycle
 from . import _persistence
 from . import _registry as registry
 from ._boundary_pressure import BoundaryPressure
@@ -392,7 +393,8 @@ class FlowEngine(PyRunner):
         """One step, all or nothing: if any part fails (the core's step, blockHook, a boundary load, the
         time-step guard after a new mesh, the forces to YADE), the core is put back as it was before
         the step (its mesh, system, results and history) and the exception goes to YADE."""
-        if not self._options.pressureForce:  # YADE's pressureForce=False: no flow at all
+        # YADE's pressureForce=False: no flow at all; nor once Python is about to finalize (_lifecycle)
+        if not self._options.pressureForce or _lifecycle.exiting():
             return
         scene = yade.O
         clock = StepClock(self._timings) if scene.timingEnabled else _IDLE_CLOCK

@@ -3,10 +3,12 @@
     yade-double -n -x tests/pfv_testing/load_child.py SCENE MODE SETTINGS
 
 MODE is when the script imports pfv: "before" the load, "after" it, or "never" (the restored PyRunner's command
-imports it at the first step). SETTINGS is JSON, label -> bndCondValue, set on each label after the load (and after
-the import), before the first step. Prints one line "RESULT <json>": what each label named before the step, whether
-a query on it answered then, how many iterations ran until every label named a pfv.FlowEngine (at most 3), and after
-one more iteration without pfv imported, the label's type, viscosity, pore pressures and inlet flux.
+imports it at the first step); "refused" is "never" with viscosity = -1 set on the first label before the first
+step, which must fail naming it, and then the viscosity set to its saved value. SETTINGS is JSON, label ->
+[bndCondValue, inlet wall, saved viscosity]: each label gets its bndCondValue after the load (and after the import),
+before the first step. Prints one line "RESULT <json>": what each label named before the step, whether a query on it
+answered then, how many iterations ran until every label named a pfv.FlowEngine (at most 3), and after one more
+iteration without pfv imported, the label's type, viscosity, pore pressures and inlet flux.
 Nothing of pfv nor pfv_testing is imported here, so that "never" means never.
 """
 import builtins
@@ -27,14 +29,9 @@ def sample(engine, inlet):
     }
 
 
-def main(path, mode, settings):
-    if mode == "before":
-        import pfv  # noqa: F401
-    O.load(path)
-    if mode == "after":
-        import pfv  # noqa: F401, F811
-    out = {"pfv_imported_before_step": "pfv" in sys.modules, "before_step": {}, "query_before_step": {}, "after": {}}
-    for label, (values, _) in settings.items():
+def before_step(settings, out):
+    """What each label names and answers after the load; its new boundary pressures."""
+    for label, (values, _, _) in settings.items():
         engine = getattr(builtins, label)
         out["before_step"][label] = type(engine).__name__
         try:
@@ -43,6 +40,31 @@ def main(path, mode, settings):
         except AttributeError as error:
             out["query_before_step"][label] = f"AttributeError: {error}"
         engine.bndCondValue = values
+
+
+def refused_step(settings, out):
+    """viscosity = -1 on the first label, a step (which must fail), then the saved viscosity."""
+    first = next(iter(settings))
+    getattr(builtins, first).viscosity = -1.0
+    try:
+        O.run(1, True)
+        out["refused"] = "no error"
+    except Exception as error:  # noqa: BLE001
+        out["refused"] = f"{type(error).__name__}: {error}"
+    out["refused_label"] = type(getattr(builtins, first)).__name__
+    getattr(builtins, first).viscosity = settings[first][2]
+
+
+def main(path, mode, settings):
+    if mode == "before":
+        import pfv  # noqa: F401
+    O.load(path)
+    if mode == "after":
+        import pfv  # noqa: F401, F811
+    out = {"pfv_imported_before_step": "pfv" in sys.modules, "before_step": {}, "query_before_step": {}, "after": {}}
+    before_step(settings, out)
+    if mode == "refused":
+        refused_step(settings, out)
     # Without pfv the restored PyRunners take over at their first run, which YADE defers by an iteration
     # for a scene saved in the middle of an iteration if they had run in it (their schedule says so); an
     # engine taken over by another's run steps in the next iteration.
@@ -52,9 +74,9 @@ def main(path, mode, settings):
         out["iterations_to_take_over"] += 1
         if all(type(getattr(builtins, label)).__name__ == "FlowEngine" for label in settings):
             break
-    if mode == "never":
+    if mode in ("never", "refused"):
         O.run(1, True)
-    for label, (_, inlet) in settings.items():
+    for label, (_, inlet, _) in settings.items():
         out["after"][label] = sample(getattr(builtins, label), inlet)
     print("RESULT " + json.dumps(out), flush=True)
 

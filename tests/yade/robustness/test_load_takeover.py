@@ -6,7 +6,7 @@ The cases are the product of:
 * how the scene is saved and loaded in this process: O.save/O.load, O.save/O.reload, O.saveTmp/O.loadTmp,
   O.sceneToString/O.stringToScene; or saved to a file and loaded by a fresh process (pfv_testing/load_child.py)
   that imports pfv before the load, after it, or never (the restored PyRunner's command imports it at the first
-  step);
+  step; twice with a setting the engine refuses made before that step);
 * whether the save is made while O.run() runs in the background (the scene is then saved in the middle of an
   iteration: YADE keeps the engines put in place at the load for the next iteration and binds the labels to the
   restored PyRunners) or between runs;
@@ -145,7 +145,7 @@ def saved_file(running, labels):
 def fresh_process_case(path, running, labels, mode, ref):
     name = f"fresh process, pfv imported {mode}, {'saved while running' if running else 'saved between runs'}, "
     name += "+".join(labels)
-    settings = {label: (ENGINES[label][3], ENGINES[label][4]) for label in labels}
+    settings = {label: (ENGINES[label][3], ENGINES[label][4], ENGINES[label][1]) for label in labels}
     out = subprocess.run(
         ["yade-double", "-n", "-x", CHILD, path, mode, json.dumps(settings)], capture_output=True, text=True
     )
@@ -157,7 +157,14 @@ def fresh_process_case(path, running, labels, mode, ref):
     for label in labels:
         before = result["before_step"][label]
         taken = result["iterations_to_take_over"]
-        if mode == "never":
+        if mode == "refused" and label == labels[0]:
+            message = result["refused"]
+            checks.check(
+                f"{name}: the refused setting fails the first step, naming it and pfv; the scene as it was",
+                "viscosity" in message and "import pfv" in message and result["refused_label"] == "PyRunner",
+                f"({message.splitlines()[-1][:160]})",
+            )
+        if mode in ("never", "refused"):
             # YADE binds the label to the restored PyRunner and nothing of pfv runs before the first step;
             # for a scene saved mid-iteration YADE may skip the runner in the iteration it runs again.
             checks.check(
@@ -165,7 +172,9 @@ def fresh_process_case(path, running, labels, mode, ref):
                 not result["pfv_imported_before_step"] and before == "PyRunner",
                 f"({before}; a query: {result['query_before_step'][label]})",
             )
-            checks.check(f"{name}: taken over at the first run of the runner", taken <= (2 if running else 1), taken)
+            # After the refused step YADE finishes the interrupted iteration without running the engine.
+            limit = (2 if running else 1) + (mode == "refused")
+            checks.check(f"{name}: taken over at the first run of the runner", taken <= limit, taken)
         else:
             checks.check(f"{name}: '{label}' names a pfv.FlowEngine before any step", before == "FlowEngine", before)
             checks.check(f"{name}: the engine runs in the first iteration", taken == 1, taken)
@@ -203,7 +212,8 @@ checks.check("a save while running is loaded mid-iteration (the case YADE binds 
 for running in (False, True):
     for labels in LABEL_SETS:
         path = saved_file(running, labels)
-        for mode in ("before", "after", "never"):
+        modes = ("before", "after", "never") + (("refused",) if running == (len(labels) == 2) else ())
+        for mode in modes:
             guarded(f"fresh process, {mode}", fresh_process_case, path, running, labels, mode, ref)
             cases += 1
 print(f"{cases} cases, {mid_iteration} of the saves while running loaded mid-iteration")

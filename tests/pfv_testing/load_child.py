@@ -46,11 +46,15 @@ def refused_step(settings, out):
     """viscosity = -1 on the first label, a step (which must fail), then the saved viscosity."""
     first = next(iter(settings))
     getattr(builtins, first).viscosity = -1.0
-    try:
-        O.run(1, True)
-        out["refused"] = "no error"
-    except Exception as error:  # noqa: BLE001
-        out["refused"] = f"{type(error).__name__}: {error}"
+    out["refused"] = "no error"
+    # The runner's first run: in the first iteration, or in the second for a scene saved in the middle
+    # of an iteration in which it had run (YADE runs that iteration again without it).
+    for _ in range(2):
+        try:
+            O.run(1, True)
+        except Exception as error:  # noqa: BLE001
+            out["refused"] = f"{type(error).__name__}: {error}"
+            break
     out["refused_label"] = type(getattr(builtins, first)).__name__
     getattr(builtins, first).viscosity = settings[first][2]
 

@@ -74,7 +74,7 @@ double Refinement::estimate_contraction(const SymmetricMatrix& s, const MatrixRo
   for (int it = 0; it < kPowerIterations; ++it) {
     for (double& x : v) x /= norm;
     residual(s, rows, zero, v, residual_, &residual_loop_);  // -G v
-    m.solve(residual_, gv);                 // -M^-1 G v
+    m.solve(residual_, gv);                                  // -M^-1 G v
     for (int i = 0; i < n; ++i) v[i] += gv[i];
     const double next = max_abs(v);
     ratio = next;  // |E v| / |v| with |v| = 1

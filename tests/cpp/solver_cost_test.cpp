@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 using namespace pfv;
 
 namespace {
@@ -88,6 +90,22 @@ TEST(SolverCost, ASystemLeavesItsStepsAndIterations) {
   for (int iterations : {13, 11, 12, 11, 100}) busy.add(iterations);
   EXPECT_DOUBLE_EQ(busy.history(before, true).multigrid_iterations, 11);
   EXPECT_EQ(SolveTally{}.history(before, true).steps_per_system, 50);  // never solved: nothing learnt
+}
+
+TEST(SolverCost, AStepUndoneLeavesTheTallyAsBefore) {
+  for (int taken : {0, 1, 3, 200}) {  // the cold start, a steady step, a busy one, one beyond the counted range
+    SolveTally tally;
+    for (int iterations : {14, 1, 1, 2, 1}) tally.add(iterations);
+    const SolveTally before = tally;
+    tally.add(taken);
+    tally.remove(taken);
+    EXPECT_EQ(tally.steps, before.steps) << taken;
+    EXPECT_EQ(tally.steps_with, before.steps_with) << taken;
+  }
+  SolveTally first;  // the first step is the cold start: not counted, and taken back as such
+  first.add(14);
+  first.remove(14);
+  EXPECT_EQ(first.steps, 0);
 }
 
 TEST(SolverCost, InputsFollowTheScheduleAndTheHistory) {

@@ -271,8 +271,9 @@ void FlowEngine::solve(double dt) {
     SolveControl control = settings.solve_control();
     control.time_step = dt;  // multigrid's start: extrapolated in time
     last_solve_ = solver.solve(rhs_, solution_, control);
-    linear_.tally.add(last_solve_.cg_iterations);     // undone with the step (begin_undo keeps a copy)
-    keep_trend_ = solver.wants_extrapolated_start();  // false once promoted to a double factor
+    linear_.tally.add(last_solve_.cg_iterations);
+    undo_.tallied_iterations = last_solve_.cg_iterations;  // taken back if the step is undone
+    keep_trend_ = solver.wants_extrapolated_start();       // false once promoted to a double factor
     for (int u = 0; u < nu; ++u) next_pressure_[system.unknown_cell[u]] = solution_[u];
   }
   step_times_.solve = seconds_since(t0);

@@ -184,8 +184,8 @@ class FlowEngine {
     // The linear system the step replaced (adopt, rebuild_stale_system), when it did.
     bool system_replaced = false;
     LinearSystem linear;
-    // Taken at the start: the counts, flags and schedule.
-    SolveTally tally;
+    // Taken at the start: the counts, flags and schedule; solve()'s count in the system's tally.
+    int tallied_iterations = -1;  // none
     SolveHistory history;
     SolveStats last_solve;
     Remesher::Schedule schedule;

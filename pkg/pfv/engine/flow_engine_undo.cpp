@@ -30,7 +30,6 @@ void FlowEngine::begin_undo() {
   undo_.reset();
   Undo& u = undo_;
   u.open = true;
-  u.tally = linear_.tally;
   u.history = solve_history_;
   u.last_solve = last_solve_;
   u.schedule = remesher_.schedule();
@@ -99,8 +98,8 @@ bool FlowEngine::retract_step() {
   }
   if (u.system_replaced)
     linear_ = std::move(u.linear);  // without its factor: the next step builds it again
-  else
-    linear_.tally = std::move(u.tally);
+  else if (u.tallied_iterations >= 0)
+    linear_.tally.remove(u.tallied_iterations);
   solve_history_ = u.history;
   last_solve_ = u.last_solve;
   // A background remesh the step started took its inputs (settings, conditions, positions) as

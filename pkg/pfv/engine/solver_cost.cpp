@@ -34,12 +34,21 @@ double iteration_cost(const CostInputs& in) {
 
 }  // namespace
 
+namespace {
+constexpr int kCounted = 64;  // iterations counted apart; beyond, the factor wins at any size this counts for
+}  // namespace
+
 void SolveTally::add(int cg_iterations) {
-  if (steps++ == 0) return;     // a cold start
-  constexpr int kCounted = 64;  // beyond, the factor wins at any size this counts for
+  if (steps++ == 0) return;  // a cold start
   const auto k = static_cast<std::size_t>(std::clamp(cg_iterations, 0, kCounted));
   if (steps_with.size() <= k) steps_with.resize(k + 1, 0);
   ++steps_with[k];
+}
+
+void SolveTally::remove(int cg_iterations) {
+  if (steps == 0 || --steps == 0) return;  // the cold start was not counted
+  --steps_with[static_cast<std::size_t>(std::clamp(cg_iterations, 0, kCounted))];
+  while (!steps_with.empty() && steps_with.back() == 0) steps_with.pop_back();  // as add() left it
 }
 
 SolveHistory SolveTally::history(SolveHistory before, bool multigrid) const {

@@ -32,6 +32,8 @@ struct SolveTally {
   std::vector<long> steps_with;  // steps after the first by CG iterations (the last: that many or more)
 
   void add(int cg_iterations);
+  // Takes back the last add(cg_iterations) (a step undone).
+  void remove(int cg_iterations);
   // The history it leaves: the steps, and the median iterations per step if multigrid solved them.
   SolveHistory history(SolveHistory before, bool multigrid) const;
 };

@@ -166,12 +166,14 @@ def print_row(n, solver, stage, one, two, note=''):
 # threads it can use). The structural fractions are those of the code: dV/dt and the forces are single loops over
 # cells and vertices on the team; the rest of the core's step and the exchange with YADE run on one thread; the
 # Cholesky solve is the substitution, planned for two groups of subtrees (ParallelSubstitution::plan(view, 2)), and
-# the refinement's residual, both on the team (its O(n) vector operations are left out); hypre's multigrid has no
-# OpenMP (Debian's build). Bandwidth-bound: the Cholesky solve streams the factor and the forces stream S (28 bytes
-# per two flops); dV/dt computes a determinant per cell from four gathered centres.
+# the refinement's residual, both on the team (its O(n) vector operations are left out); the multigrid solve is PFV's
+# V-cycle and CG on the team, over at most 16 Gauss-Seidel blocks per level (AmgCycle::kMaxBlocks), with its start
+# from the solution history, the history's update and the copies in and out on one thread: 0.08 of a one-iteration
+# solve at 200 000 spheres. Bandwidth-bound: both solves (the factor, the hierarchy's matrices) and the forces (S,
+# 28 bytes per two flops); dV/dt computes a determinant per cell from four gathered centres.
 MODEL_STAGES = (
     ('volumes', 'core', False, {'cholesky': 0.0, 'multigrid': 0.0}, None),
-    ('solve', 'core', True, {'cholesky': 0.0, 'multigrid': 1.0}, {'cholesky': 2}),
+    ('solve', 'core', True, {'cholesky': 0.0, 'multigrid': 0.08}, {'cholesky': 2, 'multigrid': 16}),
     ('forces', 'core', True, {'cholesky': 0.0, 'multigrid': 0.0}, None),
     ('rest', 'core', True, {'cholesky': 1.0, 'multigrid': 1.0}, None),
     ('read positions', 'exchange', True, {'cholesky': 1.0, 'multigrid': 1.0}, None),

@@ -4,14 +4,15 @@
 //
 //     mpirun -np P build/pfv_amg_solve FOLDER [--tolerance=1e-10] [--out=FILE] [--repeat=0]
 //         [--strong=0.5] [--coarsen=10] [--interp=6] [--pmax=4] [--relax=8] [--relax-down=R] [--relax-up=R]
-//         [--aggressive=0] [--print=0]
+//         [--aggressive=0] [--print=0] [--hypre-cycle]
 //
 // The solve starts from zero and stops by the engine's rule (estimated error below tolerance
 // times the spread of the pressures). Prints the processes, unknowns, levels, iterations, the
 // set-up and solve times and max |x - x_engine| / spread; --out writes the solution as a Matrix
 // Market array (rank 0). --repeat=K then times K solves from the solution perturbed by 1e-3 of
 // its spread (a warm start, as the engine's between remeshes). The other options are BoomerAMG's
-// (amg_pcg.hpp, AmgParameters). Exit 1 on any error.
+// (amg_pcg.hpp, AmgParameters); --hypre-cycle runs hypre's V-cycle on one process, where the
+// engine runs its own on the OpenMP threads. Exit 1 on any error.
 #include <mpi.h>
 
 #include <algorithm>
@@ -69,6 +70,8 @@ int run(int argc, char** argv) {
       parameters.relax_up = std::stoi(value);
     else if (arg.rfind("--aggressive=", 0) == 0)
       parameters.aggressive_levels = std::stoi(value);
+    else if (arg == "--hypre-cycle")
+      parameters.hypre_cycle = true;
     else if (arg.rfind("--print=", 0) == 0)
       parameters.print_level = std::stoi(value);
     else

@@ -8,10 +8,14 @@
 #include <cmath>
 #include <mutex>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 
+#include "pfv/common/parallel.hpp"
+#include "pfv/common/stage_timer.hpp"
+#include "pfv/linalg/amg_cycle.hpp"
 #include "pfv/linalg/solution_history.hpp"
 
 namespace pfv {
@@ -62,10 +66,30 @@ struct WorkVector {
   double* end() const { return data + n; }
 };
 
-double dot(HYPRE_ParVector a, HYPRE_ParVector b) {
-  double d = 0;
-  HYPRE_ParVectorInnerProd(a, b, &d);
-  return d;
+// A level's compressed rows out of hypre's (one process: every column is local).
+CsrRows local_rows(hypre_ParCSRMatrix* m) {
+  if (hypre_CSRMatrixNumCols(hypre_ParCSRMatrixOffd(m)) != 0)
+    throw std::logic_error("a multigrid level on one process has columns of another");
+  const hypre_CSRMatrix* d = hypre_ParCSRMatrixDiag(m);
+  CsrRows rows;
+  rows.n_rows = hypre_CSRMatrixNumRows(d);
+  rows.n_cols = hypre_CSRMatrixNumCols(d);
+  const HYPRE_Int* start = hypre_CSRMatrixI(d);
+  rows.start.assign(start, start + rows.n_rows + 1);
+  const HYPRE_Int* column = hypre_CSRMatrixJ(d);
+  rows.column.assign(column, column + rows.start.back());
+  const double* value = hypre_CSRMatrixData(d);
+  rows.value.assign(value, value + rows.start.back());
+  return rows;
+}
+
+// PFV's smoother for hypre's relax types, where it has one.
+std::optional<MultigridSmoother> smoother_of(const AmgParameters& p) {
+  if (p.relax_down == 13 && p.relax_up == 14) return MultigridSmoother::kSplitGaussSeidel;
+  if (p.relax_down >= 0 || p.relax_up >= 0) return std::nullopt;
+  if (p.relax_type == 18) return MultigridSmoother::kJacobi;
+  if (p.relax_type == 8) return MultigridSmoother::kGaussSeidel;
+  return std::nullopt;
 }
 
 }  // namespace
@@ -93,6 +117,11 @@ struct AmgPcg::Impl {
   // b, x and the iteration's residual, preconditioned residual, direction and G times it.
   mutable WorkVector b, x, r, z, p, q;
   SolutionHistory history;  // the last solutions, for the start of the next solve
+  // On one process: the V-cycle and the products with G on PFV's threads (amg_cycle.hpp), and
+  // hypre's matrix and hierarchy freed; on more, hypre's, on one thread per process.
+  std::unique_ptr<AmgCycle> cycle;
+  LoopChoice cycle_choice;  // the cycle on the team or on one thread, by time per iteration
+  mutable bool team = false;
 
   Impl(MPI_Comm c, int first_row, int count, int kept_solutions)
       : comm(c),
@@ -109,24 +138,36 @@ struct AmgPcg::Impl {
   // x <- the start from the history and x, the caller's start (solution_history.hpp).
   void start_from_history(double step) {
     if (history.adopt_start(x.data)) {
-      HYPRE_ParCSRMatrixMatvec(1.0, a, x.par, 0.0, q.par);  // G x, once per start the history lacks
+      multiply(x, q);  // G x, once per start the history lacks
       history.add(x.data, q.data, step);
     }
     history.predict(b.data, x.data, step);
   }
 
   void precondition() const {  // z = M^-1 r: one V-cycle from zero
+    if (cycle) return cycle->apply(r.data, z.data, team);
     std::fill(z.begin(), z.end(), 0.0);
     HYPRE_BoomerAMGSolve(amg.get(), a, r.par, z.par);
   }
+  void multiply(const WorkVector& in, WorkVector& out) const {  // out = G in
+    if (cycle) return cycle->multiply(1.0, in.data, 0.0, out.data, team);
+    HYPRE_ParCSRMatrixMatvec(1.0, a, in.par, 0.0, out.par);
+  }
   void residual() const {  // r = b - G x
     std::copy(b.begin(), b.end(), r.begin());
+    if (cycle) return cycle->multiply(-1.0, x.data, 1.0, r.data, team);
     HYPRE_ParCSRMatrixMatvec(-1.0, a, x.par, 1.0, r.par);
+  }
+  double dot(const WorkVector& u, const WorkVector& v) const {
+    if (cycle) return fixed_chunk_dot(u.data, v.data, n, team);
+    double d = 0;
+    HYPRE_ParVectorInnerProd(u.par, v.par, &d);
+    return d;
   }
   double residual_ratio() const {
     residual();
-    const double bb = dot(b.par, b.par);
-    return bb > 0 ? std::sqrt(dot(r.par, r.par) / bb) : std::sqrt(dot(r.par, r.par));
+    const double bb = dot(b, b);
+    return bb > 0 ? std::sqrt(dot(r, r) / bb) : std::sqrt(dot(r, r));
   }
 
   // The preconditioned CG iteration from x; `stop(k, alpha)` after each update of x.
@@ -135,25 +176,28 @@ struct AmgPcg::Impl {
     residual();
     precondition();
     std::copy(z.begin(), z.end(), p.begin());
-    double rz = dot(r.par, z.par);
+    double rz = dot(r, z);
+    const bool par = team && n >= kMinParallelLoop;
     for (int k = 1; k <= max_iterations; ++k) {
       if (rz <= 0) return k - 1;  // r = 0: x is the solution
-      HYPRE_ParCSRMatrixMatvec(1.0, a, p.par, 0.0, q.par);
-      const double pq = dot(p.par, q.par);
+      multiply(p, q);
+      const double pq = dot(p, q);
       if (!(pq > 0))
         throw std::domain_error(
             "the multigrid-preconditioned CG met a direction of non-positive "
             "curvature: the system is not positive definite");
       const double alpha = rz / pq;
+#pragma omp parallel for schedule(static) if (par)
       for (int i = 0; i < n; ++i) {
         x.data[i] += alpha * p.data[i];
         r.data[i] -= alpha * q.data[i];
       }
       if (stop(k, alpha)) return k;
       precondition();
-      const double next = dot(r.par, z.par);
+      const double next = dot(r, z);
       const double beta = next / rz;
       rz = next;
+#pragma omp parallel for schedule(static) if (par)
       for (int i = 0; i < n; ++i) p.data[i] = z.data[i] + beta * p.data[i];
     }
     return -1;
@@ -214,10 +258,33 @@ AmgPcg::AmgPcg(MPI_Comm comm, const DistributedRows& rows, const AmgParameters& 
   if (parameters.relax_up >= 0) HYPRE_BoomerAMGSetCycleRelaxType(amg, parameters.relax_up, 2);
   HYPRE_BoomerAMGSetAggNumLevels(amg, parameters.aggressive_levels);
   check(HYPRE_BoomerAMGSetup(amg, m.a, m.b.par, m.x.par), "BoomerAMGSetup");
+  auto* data = reinterpret_cast<hypre_ParAMGData*>(amg);
+  levels_ = hypre_ParAMGDataNumLevels(data);
+  const HYPRE_Int* relax = hypre_ParAMGDataGridRelaxType(data);
+  relax_types_ = {static_cast<int>(relax[1]), static_cast<int>(relax[2])};  // [1] down, [2] up
 
+  int processes = 1;
+  MPI_Comm_size(comm, &processes);
+  const std::optional<MultigridSmoother> smoother = smoother_of(parameters);
+  if (processes == 1 && smoother && !parameters.hypre_cycle) {
+    // PFV's cycle on the same hierarchy; hypre's copies go (the system's matrix too: the cycle
+    // holds it), so the memory is that of hypre's solver alone.
+    hypre_ParCSRMatrix** a_levels = hypre_ParAMGDataAArray(data);
+    hypre_ParCSRMatrix** p_levels = hypre_ParAMGDataPArray(data);
+    std::vector<CsrRows> a, p;
+    for (int l = 0; l < levels_; ++l) {
+      a.push_back(local_rows(a_levels[l]));
+      if (l + 1 < levels_) p.push_back(local_rows(p_levels[l]));
+    }
+    m.cycle = std::make_unique<AmgCycle>(std::move(a), std::move(p), *smoother);
+    operator_complexity_ = m.cycle->operator_complexity();
+    m.amg.reset();
+    m.a = nullptr;
+    m.ij.reset();
+    return;
+  }
   // The operator complexity from hypre's own data: the entries of every level's matrix (global
   // counts, the same on every process) over those of G.
-  auto* data = reinterpret_cast<hypre_ParAMGData*>(amg);
   hypre_ParCSRMatrix** a_levels = hypre_ParAMGDataAArray(data);
   double entries_g = 0, entries_all = 0;
   for (int l = 0; l < hypre_ParAMGDataNumLevels(data); ++l) {
@@ -231,14 +298,11 @@ AmgPcg::AmgPcg(MPI_Comm comm, const DistributedRows& rows, const AmgParameters& 
 
 AmgPcg::~AmgPcg() = default;
 
-int AmgPcg::levels() const { return hypre_ParAMGDataNumLevels(reinterpret_cast<hypre_ParAMGData*>(impl_->amg.get())); }
+int AmgPcg::levels() const { return levels_; }
 
 int AmgPcg::kept_solutions() const { return impl_->history.size(); }
 
-std::array<int, 2> AmgPcg::cycle_relax_types() const {
-  const HYPRE_Int* type = hypre_ParAMGDataGridRelaxType(reinterpret_cast<hypre_ParAMGData*>(impl_->amg.get()));
-  return {static_cast<int>(type[1]), static_cast<int>(type[2])};  // [1] down, [2] up ([0] fine, [3] coarsest)
-}
+std::array<int, 2> AmgPcg::cycle_relax_types() const { return relax_types_; }
 
 AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x, double tolerance, int max_iterations,
                             double step) {
@@ -247,6 +311,8 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
     throw std::invalid_argument("the multigrid solve needs one value of b and x per local row");
   std::copy(b.begin(), b.end(), m.b.begin());
   std::copy(x.begin(), x.end(), m.x.begin());
+  m.team = m.cycle_choice.team(m.n);
+  const auto t0 = StageClock::now();
   m.start_from_history(step);
   constexpr double kNegligibleUpdate = 1e-3, kSeedSafety = 2;
   // The first solve on a system goes on to kMeasuringTolerance at least, for a contraction
@@ -258,6 +324,7 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
   int ratios = 0;  // since the estimate last started
   const auto stop = [&](int k, double alpha) {
     double d = 0, lo = m.x.data[0], hi = m.x.data[0], size = 0;
+#pragma omp parallel for schedule(static) reduction(max : d, hi, size) reduction(min : lo) if (m.team)
     for (int i = 0; i < m.n; ++i) {
       d = std::max(d, std::abs(alpha * m.p.data[i]));
       lo = std::min(lo, m.x.data[i]);
@@ -300,6 +367,7 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
   stats.iterations = k >= 0 ? k : max_iterations;
   if (stats.iterations >= 3) seen_ratio_ = largest;
   m.history.add_provisional(m.x.data, m.b.data, m.r.data, step);
+  m.cycle_choice.done(seconds_since(t0) / std::max(1, stats.iterations));
   std::copy(m.x.begin(), m.x.end(), x.begin());
   return stats;
 }
@@ -311,8 +379,8 @@ AmgSolveStats AmgPcg::solve_to_residual(const std::vector<double>& b, std::vecto
     throw std::invalid_argument("the multigrid solve needs one value of b and x per local row");
   std::copy(b.begin(), b.end(), m.b.begin());
   std::copy(x.begin(), x.end(), m.x.begin());
-  const double target = relative_residual * std::sqrt(dot(m.b.par, m.b.par));
-  const auto stop = [&](int, double) { return std::sqrt(dot(m.r.par, m.r.par)) <= target; };
+  const double target = relative_residual * std::sqrt(m.dot(m.b, m.b));
+  const auto stop = [&](int, double) { return std::sqrt(m.dot(m.r, m.r)) <= target; };
   AmgSolveStats stats;
   const int k = target > 0 ? m.iterate(max_iterations, stop) : 0;
   if (target == 0) std::fill(m.x.begin(), m.x.end(), 0.0);

@@ -69,6 +69,10 @@ struct AmgParameters {
   // and direction where the symmetric Gauss-Seidel makes two (bench/amg/amg_solve.cpp).
   int relax_down = -1, relax_up = -1;
   int aggressive_levels = 0;  // levels of aggressive coarsening (less memory, more iterations)
+  // On one process, with the smoothers above (8, 18, or 13 down and 14 up), the V-cycle is PFV's
+  // (amg_cycle.hpp: on the threads, hypre's copies freed); true keeps hypre's, for comparison.
+  // Other relax types and several processes always run hypre's.
+  bool hypre_cycle = false;
   int print_level = 0;        // hypre's report of the hierarchy (1: at set-up, on stdout)
   // Solutions (and their products with G) kept to start the next solve from (solve(), below); 0:
   // every solve starts from the x it is given. At most kMaxStartHistory.
@@ -120,6 +124,8 @@ class AmgPcg {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   double operator_complexity_ = 0;
+  int levels_ = 0;
+  std::array<int, 2> relax_types_{};
   double seen_ratio_ = 0;  // the largest update ratio of the last solve with three iterations or more
 };
 

@@ -1,6 +1,8 @@
-// Conjugate gradients on G preconditioned by one V-cycle of algebraic multigrid (hypre's
-// BoomerAMG), over the rows of G one MPI process owns: a pressure solve whose memory grows as
-// O(N), where the Cholesky factor grows as N^(4/3) on a three-dimensional pore network.
+// Conjugate gradients on G preconditioned by one V-cycle of algebraic multigrid (the hierarchy
+// hypre's BoomerAMG builds), over the rows of G one MPI process owns: a pressure solve whose
+// memory grows as O(N), where the Cholesky factor grows as N^(4/3) on a three-dimensional pore
+// network. On one process the V-cycle, the products with G and the vector operations are PFV's,
+// on the OpenMP team or on one thread with the same bits (amg_cycle.hpp); on several, hypre's.
 //
 // The hierarchy is built once per system (at a remesh) and reused by every solve. The
 // iteration is written here, not taken from hypre's PCG, for its stopping rule: the engine's
@@ -73,7 +75,7 @@ struct AmgParameters {
   // (amg_cycle.hpp: on the threads, hypre's copies freed); true keeps hypre's, for comparison.
   // Other relax types and several processes always run hypre's.
   bool hypre_cycle = false;
-  int print_level = 0;        // hypre's report of the hierarchy (1: at set-up, on stdout)
+  int print_level = 0;  // hypre's report of the hierarchy (1: at set-up, on stdout)
   // Solutions (and their products with G) kept to start the next solve from (solve(), below); 0:
   // every solve starts from the x it is given. At most kMaxStartHistory.
   int start_history = 0;

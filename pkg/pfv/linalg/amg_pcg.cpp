@@ -312,6 +312,7 @@ AmgSolveStats AmgPcg::solve(const std::vector<double>& b, std::vector<double>& x
   std::copy(b.begin(), b.end(), m.b.begin());
   std::copy(x.begin(), x.end(), m.x.begin());
   m.team = m.cycle_choice.team(m.n);
+  m.history.use_team(m.team);
   const auto t0 = StageClock::now();
   m.start_from_history(step);
   constexpr double kNegligibleUpdate = 1e-3, kSeedSafety = 2;

@@ -5,10 +5,17 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "pfv/common/parallel.hpp"
+
 namespace pfv {
 namespace {
 
 constexpr int kMax = 4;  // entries the per-row tables below hold
+// Sums over the rows are added over this many fixed chunks, in order: the same bits on one
+// thread as on the team.
+constexpr int kChunks = 64;
+
+int chunk_begin(int n, int k) { return static_cast<int>(static_cast<long long>(n) * k / kChunks); }
 
 // Weights of the polynomial through (t[j], x_j), j = 0 ... order, at time target (Lagrange).
 std::array<double, kMax> lagrange(const std::array<double, kMax>& t, int order, double target) {
@@ -31,9 +38,13 @@ SolutionHistory::SolutionHistory(MPI_Comm comm, int n, int capacity) : comm_(com
   gx_.assign(capacity, std::vector<double>(n));
 }
 
+bool SolutionHistory::on_team() const { return team_ && n_ >= kMinParallelLoop; }
+
 bool SolutionHistory::equals_newest(const double* v) const {
-  const std::vector<double>& x = newest();
-  int local = std::equal(x.begin(), x.end(), v) ? 1 : 0, global = 0;
+  const double* x = newest().data();
+  int local = 1, global = 0;
+#pragma omp parallel for schedule(static) reduction(min : local) if (on_team())
+  for (int i = 0; i < n_; ++i) local = std::min(local, x[i] == v[i] ? 1 : 0);
   MPI_Allreduce(&local, &global, 1, MPI_INT, MPI_MIN, comm_);
   return global == 1;
 }
@@ -54,7 +65,9 @@ bool SolutionHistory::adopt_start(const double* start) {
   // Pressures of the same instant as the newest entry, changed by the caller, or of no solve on
   // this system: the trend of the kept ones no longer leads to them.
   clear();
-  int local = std::all_of(start, start + n_, [](double v) { return v == 0; }) ? 1 : 0, zero = 0;
+  int local = 1, zero = 0;
+#pragma omp parallel for schedule(static) reduction(min : local) if (on_team())
+  for (int i = 0; i < n_; ++i) local = std::min(local, start[i] == 0 ? 1 : 0);
   MPI_Allreduce(&local, &zero, 1, MPI_INT, MPI_MIN, comm_);
   return zero == 0;
 }
@@ -74,7 +87,8 @@ void SolutionHistory::add(const double* x, const double* gx, double step) {
 void SolutionHistory::add_provisional(const double* x, const double* b, const double* r, double step) {
   if (capacity() == 0) return;
   int local = 1, finite = 0;
-  for (int i = 0; i < n_ && local; ++i) local = std::isfinite(x[i]) && std::isfinite(b[i] - r[i]);
+#pragma omp parallel for schedule(static) reduction(min : local) if (on_team())
+  for (int i = 0; i < n_; ++i) local = std::min(local, std::isfinite(x[i]) && std::isfinite(b[i] - r[i]) ? 1 : 0);
   MPI_Allreduce(&local, &finite, 1, MPI_INT, MPI_MIN, comm_);
   if (!finite) {
     clear();
@@ -85,8 +99,9 @@ void SolutionHistory::add_provisional(const double* x, const double* b, const do
   time_[head_] = t;
   step_[head_] = step;
   count_ = std::min(count_ + 1, capacity());
-  std::vector<double>& keep = x_[head_];
-  std::vector<double>& product = gx_[head_];
+  double* keep = x_[head_].data();
+  double* product = gx_[head_].data();
+#pragma omp parallel for schedule(static) if (on_team())
   for (int i = 0; i < n_; ++i) {
     keep[i] = x[i];
     product[i] = b[i] - r[i];
@@ -113,13 +128,18 @@ int SolutionHistory::predict(const double* b, double* x, double step) {
   for (int order = 0; order < orders; ++order) w[order] = lagrange(t, order, target);
   // One pass for the residual b - G x of each extrapolation, entry by entry (b and G x agree to
   // many digits: a difference of norms would lose them).
+  std::array<std::array<double, kMax>, kChunks> part{};
+#pragma omp parallel for schedule(static) if (on_team())
+  for (int c = 0; c < kChunks; ++c)
+    for (int i = chunk_begin(n_, c); i < chunk_begin(n_, c + 1); ++i)
+      for (int order = 0; order < orders; ++order) {
+        double r = b[i];
+        for (int j = 0; j <= order; ++j) r -= w[order][j] * gs[j][i];
+        part[c][order] += r * r;
+      }
   std::array<double, kMax> local{}, global{};
-  for (int i = 0; i < n_; ++i)
-    for (int order = 0; order < orders; ++order) {
-      double r = b[i];
-      for (int j = 0; j <= order; ++j) r -= w[order][j] * gs[j][i];
-      local[order] += r * r;
-    }
+  for (const auto& p : part)
+    for (int order = 0; order < orders; ++order) local[order] += p[order];
   MPI_Allreduce(local.data(), global.data(), orders, MPI_DOUBLE, MPI_SUM, comm_);
   int best = 0;
   for (int order = 1; order < orders; ++order)
@@ -128,6 +148,7 @@ int SolutionHistory::predict(const double* b, double* x, double step) {
     clear();
     return -1;
   }
+#pragma omp parallel for schedule(static) if (on_team())
   for (int i = 0; i < n_; ++i) {
     double v = 0;
     for (int j = 0; j <= best; ++j) v += w[best][j] * xs[j][i];

@@ -31,6 +31,9 @@ class SolutionHistory {
   SolutionHistory(MPI_Comm comm, int n, int capacity);
 
   int size() const { return count_; }
+  // Whether the passes over the rows may run on the calling thread's team (from
+  // kMinParallelLoop rows; the same bits either way).
+  void use_team(bool team) { team_ = team; }
   int capacity() const { return static_cast<int>(x_.size()); }
   void clear() { count_ = 0, provisional_ = false; }
 
@@ -55,6 +58,7 @@ class SolutionHistory {
  private:
   const std::vector<double>& newest() const { return x_[head_]; }
   bool equals_newest(const double* v) const;  // collective
+  bool on_team() const;
   void drop_newest();
 
   MPI_Comm comm_;
@@ -65,6 +69,7 @@ class SolutionHistory {
   std::vector<double> time_, step_;
   int head_ = 0, count_ = 0;
   bool provisional_ = false;
+  bool team_ = false;
 };
 
 }  // namespace pfv

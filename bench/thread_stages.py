@@ -167,9 +167,9 @@ def print_row(n, solver, stage, one, two, note=''):
 # cells and vertices on the team; the rest of the core's step and the exchange with YADE run on one thread; the
 # Cholesky solve is the substitution, planned for two groups of subtrees (ParallelSubstitution::plan(view, 2)), and
 # the refinement's residual, both on the team (its O(n) vector operations are left out); the multigrid solve is PFV's
-# V-cycle and CG on the team, over at most 16 Gauss-Seidel blocks per level (AmgCycle::kMaxBlocks), with its start
-# from the solution history, the history's update and the copies in and out on one thread: 0.08 of a one-iteration
-# solve at 200 000 spheres. Bandwidth-bound: both solves (the factor, the hierarchy's matrices) and the forces (S,
+# V-cycle, CG and the solution history on the team, over at most 16 Gauss-Seidel blocks per level
+# (AmgCycle::kMaxBlocks), the copies in and out on one thread: s = 0.08 is an upper bound, the share measured at
+# 200 000 spheres for the copies and the history together, before the history's passes went to the team. Bandwidth-bound: both solves (the factor, the hierarchy's matrices) and the forces (S,
 # 28 bytes per two flops); dV/dt computes a determinant per cell from four gathered centres.
 MODEL_STAGES = (
     ('volumes', 'core', False, {'cholesky': 0.0, 'multigrid': 0.0}, None),

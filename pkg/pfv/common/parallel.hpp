@@ -23,6 +23,14 @@ inline int max_threads() {
 #endif
 }
 
+// Sums over a range that may run on a team are added over this many fixed chunks, in order: the
+// same bits on one thread as on a team of any size (the step's sums over cells, the multigrid
+// solve's dot products and its history's residuals).
+constexpr int kSumChunks = 64;
+
+// The first index of chunk k of [0, n) (chunk kSumChunks ends at n).
+inline int chunk_begin(long long n, int k) { return static_cast<int>(n * k / kSumChunks); }
+
 // One thread or the team for a loop run at every step, by the time each took (ScheduleChoice):
 // on free cores the team pays from kMinParallelLoop items on, on cores other processes hold the
 // fork and join wait for a descheduled thread and one thread is many times faster. The loop must

@@ -190,17 +190,16 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   next_volume_rate_.resize(nc);
   // The sums over cells by fixed chunks, added in order: the same bits on one thread or on the
   // team, whichever the measured choice runs (the inversion rule must not depend on the load).
-  constexpr int kChunks = 64;
-  std::array<int, kChunks> inverted_in{};
-  std::array<double, kChunks> inverted_volume_in{}, meshed_volume_in{};
+  std::array<int, kSumChunks> inverted_in{};
+  std::array<double, kSumChunks> inverted_volume_in{}, meshed_volume_in{};
   const bool team = volume_loop_.team(nc);
   const auto loop_start = StageClock::now();
 #pragma omp parallel for schedule(static) reduction(max : max_change) if (team)
-  for (int k = 0; k < kChunks; ++k) {
-    const int end = static_cast<int>(static_cast<long long>(nc) * (k + 1) / kChunks);
+  for (int k = 0; k < kSumChunks; ++k) {
+    const int end = chunk_begin(nc, k + 1);
     int inverted_here = 0;
     double inverted_volume_here = 0, meshed_volume_here = 0;
-    for (int c = static_cast<int>(static_cast<long long>(nc) * k / kChunks); c < end; ++c) {
+    for (int c = chunk_begin(nc, k); c < end; ++c) {
       const CellShape& shape = mesh_->cells.shape[c];
       const double v = cell_volume(shape, centres, walls);
       const bool inverted = v < inside_out;
@@ -219,7 +218,7 @@ double FlowEngine::assemble(const std::vector<Vec3>& centres, const BoxWalls& wa
   volume_loop_.done(seconds_since(loop_start));
   inverted_cells_ = 0;
   inverted_volume_ = meshed_volume_ = 0;
-  for (int k = 0; k < kChunks; ++k) {
+  for (int k = 0; k < kSumChunks; ++k) {
     inverted_cells_ += inverted_in[k];
     inverted_volume_ += inverted_volume_in[k];
     meshed_volume_ += meshed_volume_in[k];

@@ -32,10 +32,8 @@ double iteration_cost(const CostInputs& in) {
   return scale * kIterationPerUnknown * in.unknowns;
 }
 
-}  // namespace
-
-namespace {
 constexpr int kCounted = 64;  // iterations counted apart; beyond, the factor wins at any size this counts for
+
 }  // namespace
 
 void SolveTally::add(int cg_iterations) {

@@ -15,18 +15,6 @@ namespace {
 
 bool on_team(bool team, int n) { return team && n >= kMinParallelLoop; }
 
-// f(i) for i in [0, n), on the team or on this thread. The loop on one thread is not an OpenMP
-// region with an if clause, whose outlined body reads its variables through a pointer.
-template <class F>
-void for_each_index(int n, bool team, F f) {
-  if (team) {
-#pragma omp parallel for schedule(static)
-    for (int i = 0; i < n; ++i) f(i);
-  } else {
-    for (int i = 0; i < n; ++i) f(i);
-  }
-}
-
 void check_rows(const CsrRows& m, const char* what) {
   const bool ok = static_cast<int>(m.start.size()) == m.n_rows + 1 && m.start.front() == 0 &&
                   m.start.back() == static_cast<int>(m.column.size()) && m.column.size() == m.value.size() &&
@@ -54,15 +42,15 @@ CsrRows transpose(const CsrRows& m) {
 }
 
 // y = alpha M x + beta y, row by row: each row's sum in the same order on any thread. One chain
-// of additions: with four to six entries per row, two interleaved sums cost more in the loop's
-// exits than they save.
+// of additions: with four to six entries per row, two interleaved sums made the sweeps slower.
 void multiply_rows(const int* start, const int* column, const double* value, int n, double alpha, const double* x,
                    double beta, double* y, bool team) {
-  for_each_index(n, on_team(team, n), [&](int i) {
+#pragma omp parallel for schedule(static) if (on_team(team, n))
+  for (int i = 0; i < n; ++i) {
     double s = 0;
     for (int e = start[i]; e < start[i + 1]; ++e) s += value[e] * x[column[e]];
     y[i] = beta == 0 ? alpha * s : alpha * s + beta * y[i];
-  });
+  }
 }
 
 void multiply_rows(const CsrRows& m, double alpha, const double* x, double beta, double* y, bool team) {
@@ -72,14 +60,13 @@ void multiply_rows(const CsrRows& m, double alpha, const double* x, double beta,
 }  // namespace
 
 double fixed_chunk_dot(const double* a, const double* b, int n, bool team) {
-  constexpr int kChunks = 64;
-  std::array<double, kChunks> part{};
-  for_each_index(kChunks, on_team(team, n), [&](int k) {
-    const int end = static_cast<int>(static_cast<long long>(n) * (k + 1) / kChunks);
+  std::array<double, kSumChunks> part{};
+#pragma omp parallel for schedule(static) if (on_team(team, n))
+  for (int k = 0; k < kSumChunks; ++k) {
     double s = 0;
-    for (int i = static_cast<int>(static_cast<long long>(n) * k / kChunks); i < end; ++i) s += a[i] * b[i];
+    for (int i = chunk_begin(n, k); i < chunk_begin(n, k + 1); ++i) s += a[i] * b[i];
     part[k] = s;
-  });
+  }
   double sum = 0;
   for (double s : part) sum += s;
   return sum;
@@ -173,7 +160,8 @@ void AmgCycle::multiply(double alpha, const double* x, double beta, double* y, b
 void AmgCycle::refresh_halo(const Level& level, bool team) const {
   double* x = level.x_ext.data();
   const int n = level.n(), h = static_cast<int>(level.halo.size());
-  for_each_index(h, on_team(team, h), [&](int k) { x[n + k] = x[level.halo[k]]; });
+#pragma omp parallel for schedule(static) if (on_team(team, h))
+  for (int k = 0; k < h; ++k) x[n + k] = x[level.halo[k]];
 }
 
 // x += D^-1 (b - A x) row by row, Gauss-Seidel inside each block: a row reads the new values of
@@ -191,7 +179,8 @@ void AmgCycle::sweep(const Level& level, const double* b, bool forward, bool fro
   const int* column = a.column.data();
   const double* value = a.value.data();
   const double* inverse_diagonal = level.inverse_diagonal.data();
-  for_each_index(blocks, on_team(team, level.n()), [&](int k) {
+#pragma omp parallel for schedule(static) if (on_team(team, level.n()))
+  for (int k = 0; k < blocks; ++k) {
     const int lo = level.block_start[k], hi = level.block_start[k + 1];
     for (int step = 0; step < hi - lo; ++step) {
       const int i = forward ? lo + step : hi - 1 - step;
@@ -199,7 +188,7 @@ void AmgCycle::sweep(const Level& level, const double* b, bool forward, bool fro
       for (int e = start[i]; e < start[i + 1]; ++e) r -= value[e] * x[column[e]];
       x[i] += r * inverse_diagonal[i];
     }
-  });
+  }
 }
 
 void AmgCycle::jacobi(const Level& level, const double* b, bool from_zero, bool team) const {
@@ -208,17 +197,20 @@ void AmgCycle::jacobi(const Level& level, const double* b, bool from_zero, bool 
   const bool par = on_team(team, n);
   double* x = level.x_ext.data();
   if (from_zero) {
-    for_each_index(n, par, [&](int i) { x[i] = b[i] * level.inverse_diagonal[i]; });
+#pragma omp parallel for schedule(static) if (par)
+    for (int i = 0; i < n; ++i) x[i] = b[i] * level.inverse_diagonal[i];
     return;
   }
   refresh_halo(level, team);
   double* before = level.work.data();
-  for_each_index(a.n_cols, par, [&](int i) { before[i] = x[i]; });
-  for_each_index(n, par, [&](int i) {
+#pragma omp parallel for schedule(static) if (par)
+  for (int i = 0; i < a.n_cols; ++i) before[i] = x[i];
+#pragma omp parallel for schedule(static) if (par)
+  for (int i = 0; i < n; ++i) {
     double r = b[i];
     for (int e = a.start[i]; e < a.start[i + 1]; ++e) r -= a.value[e] * before[a.column[e]];
     x[i] = before[i] + r * level.inverse_diagonal[i];
-  });
+  }
 }
 
 // The pre-smoother (down, from zero) or the post-smoother (up), its adjoint.

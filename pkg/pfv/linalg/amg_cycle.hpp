@@ -37,8 +37,8 @@ struct CsrRows {
   std::vector<double> value;
 };
 
-// The dot product summed over 64 fixed chunks of the range, added in order: the same bits on
-// one thread as on the team.
+// The dot product summed over fixed chunks (kSumChunks, parallel.hpp), added in order: the same
+// bits on one thread as on the team.
 double fixed_chunk_dot(const double* a, const double* b, int n, bool team);
 
 class AmgCycle {

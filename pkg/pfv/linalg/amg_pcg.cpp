@@ -120,8 +120,8 @@ struct AmgPcg::Impl {
   // On one process: the V-cycle and the products with G on PFV's threads (amg_cycle.hpp), and
   // hypre's matrix and hierarchy freed; on more, hypre's, on one thread per process.
   std::unique_ptr<AmgCycle> cycle;
-  LoopChoice cycle_choice;  // the cycle on the team or on one thread, by time per iteration
-  mutable bool team = false;
+  LoopChoice cycle_choice;    // the cycle on the team or on one thread, by time per iteration
+  mutable bool team = false;  // cycle_choice's pick for this solve (only with kMinParallelLoop rows or more)
 
   Impl(MPI_Comm c, int first_row, int count, int kept_solutions)
       : comm(c),
@@ -177,7 +177,6 @@ struct AmgPcg::Impl {
     precondition();
     std::copy(z.begin(), z.end(), p.begin());
     double rz = dot(r, z);
-    const bool par = team && n >= kMinParallelLoop;
     for (int k = 1; k <= max_iterations; ++k) {
       if (rz <= 0) return k - 1;  // r = 0: x is the solution
       multiply(p, q);
@@ -187,7 +186,7 @@ struct AmgPcg::Impl {
             "the multigrid-preconditioned CG met a direction of non-positive "
             "curvature: the system is not positive definite");
       const double alpha = rz / pq;
-#pragma omp parallel for schedule(static) if (par)
+#pragma omp parallel for schedule(static) if (team)
       for (int i = 0; i < n; ++i) {
         x.data[i] += alpha * p.data[i];
         r.data[i] -= alpha * q.data[i];
@@ -197,7 +196,7 @@ struct AmgPcg::Impl {
       const double next = dot(r, z);
       const double beta = next / rz;
       rz = next;
-#pragma omp parallel for schedule(static) if (par)
+#pragma omp parallel for schedule(static) if (team)
       for (int i = 0; i < n; ++i) p.data[i] = z.data[i] + beta * p.data[i];
     }
     return -1;

@@ -11,11 +11,6 @@ namespace pfv {
 namespace {
 
 constexpr int kMax = 4;  // entries the per-row tables below hold
-// Sums over the rows are added over this many fixed chunks, in order: the same bits on one
-// thread as on the team.
-constexpr int kChunks = 64;
-
-int chunk_begin(int n, int k) { return static_cast<int>(static_cast<long long>(n) * k / kChunks); }
 
 // Weights of the polynomial through (t[j], x_j), j = 0 ... order, at time target (Lagrange).
 std::array<double, kMax> lagrange(const std::array<double, kMax>& t, int order, double target) {
@@ -128,9 +123,9 @@ int SolutionHistory::predict(const double* b, double* x, double step) {
   for (int order = 0; order < orders; ++order) w[order] = lagrange(t, order, target);
   // One pass for the residual b - G x of each extrapolation, entry by entry (b and G x agree to
   // many digits: a difference of norms would lose them).
-  std::array<std::array<double, kMax>, kChunks> part{};
+  std::array<std::array<double, kMax>, kSumChunks> part{};  // the residuals' sums by fixed chunks
 #pragma omp parallel for schedule(static) if (on_team())
-  for (int c = 0; c < kChunks; ++c)
+  for (int c = 0; c < kSumChunks; ++c)
     for (int i = chunk_begin(n_, c); i < chunk_begin(n_, c + 1); ++i)
       for (int order = 0; order < orders; ++order) {
         double r = b[i];

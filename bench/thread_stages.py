@@ -169,8 +169,9 @@ def print_row(n, solver, stage, one, two, note=''):
 # the refinement's residual, both on the team (its O(n) vector operations are left out); the multigrid solve is PFV's
 # V-cycle, CG and the solution history on the team, over at most 16 Gauss-Seidel blocks per level
 # (AmgCycle::kMaxBlocks), the copies in and out on one thread: s = 0.08 is an upper bound, the share measured at
-# 200 000 spheres for the copies and the history together, before the history's passes went to the team. Bandwidth-bound: both solves (the factor, the hierarchy's matrices) and the forces (S,
-# 28 bytes per two flops); dV/dt computes a determinant per cell from four gathered centres.
+# 200 000 spheres for the copies and the history together, before the history's passes went to the team.
+# Bandwidth-bound: both solves (the factor, the hierarchy's matrices) and the forces (S, 28 bytes per two flops);
+# dV/dt computes a determinant per cell from four gathered centres.
 MODEL_STAGES = (
     ('volumes', 'core', False, {'cholesky': 0.0, 'multigrid': 0.0}, None),
     ('solve', 'core', True, {'cholesky': 0.0, 'multigrid': 0.08}, {'cholesky': 2, 'multigrid': 16}),

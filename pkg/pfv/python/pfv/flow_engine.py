@@ -37,7 +37,7 @@ from . import _registry as registry
 from ._boundary_pressure import BoundaryPressure
 from ._cell_conditions import CellConditions
 from ._cell_geometry import CellGeometry
-from ._core import set_num_threads
+from ._core import get_max_threads, set_num_threads
 from ._engine import Engine
 from ._coupled_bodies import CoupledBodies
 from ._file_outputs import FileOutputs
@@ -400,17 +400,22 @@ class FlowEngine(PyRunner):
         clock = StepClock(self._timings) if scene.timingEnabled else _IDLE_CLOCK
         self._enter_scene(scene)
         stepped = self._bodies.stepped
+        # OpenMP's thread count belongs to the thread running YADE's engines: ompThreads is the flow engine's
+        # own, so the engines after it get the caller's count back.
+        caller_threads = get_max_threads()
+        set_num_threads(self._threads or scene.numThreads)
         try:
             self._step_parts(scene, clock)
         except BaseException:
             self._bodies.stepped = stepped
             self._core.retract_step()
             raise
+        finally:
+            set_num_threads(caller_threads)
         self._core.accept_step()
 
     def _step_parts(self, scene: Any, clock: Any) -> None:
         scan, pos, walls = self._bodies.for_step(scene)
-        set_num_threads(self._threads or scene.numThreads)
         clock.lap("scan and positions")
         dt = self._before_step(scene, scan)
         watch, reports = StepWatch(self._core), self._reports.before_step()

@@ -52,7 +52,7 @@ import sys
 import time
 
 from pfv_testing import paths
-from pfv_testing.lattice_scene import MOTIONS, build_scene, insert, make_flow, remove_flows
+from pfv_testing.lattice_scene import MOTIONS, build_scene, dry_steps, insert, make_flow, remove_flows
 from pfv_testing.memory import reset_peak, rss_kb
 from pfv_testing.timing import yade_step as timed_step
 
@@ -114,14 +114,7 @@ def options(argv):
 
 # ------------------------------------------------------------------------------------------------ children (in yade)
 def dry_block(flow, motion):
-    """BLOCK dry steps: `flow` taken out of O.engines for them and the spheres held still (else the engine would
-    see the motion of BLOCK + 1 steps in one), then both put back."""
-    remove_flows()
-    motion.pause()
-    steps = [timed_step() for _ in range(BLOCK)]
-    motion.resume()
-    insert(flow)
-    return steps
+    return dry_steps(flow, motion, BLOCK)
 
 
 def cg_iterations(flow, kind):

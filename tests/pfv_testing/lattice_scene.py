@@ -135,6 +135,19 @@ def insert(flow):
     O.engines = engines[:i] + [flow] + engines[i:]
 
 
+def dry_steps(flow, motion, count):
+    """Seconds of each of `count` dry steps: `flow` taken out of O.engines for them and the spheres held still (else
+    the engine would see the motion of count + 1 steps in one), then both put back."""
+    from pfv_testing.timing import yade_step
+
+    remove_flows()
+    motion.pause()
+    steps = [yade_step() for _ in range(count)]
+    motion.resume()
+    insert(flow)
+    return steps
+
+
 def remove_flows():
     from yade import O
 

@@ -1,0 +1,38 @@
+// The regular triangulation of an infinite periodic packing, one period of it.
+//
+// Every class of cells equal up to a lattice translation appears once. A cell's vertices are
+// images: sphere image_sphere[v] translated by image_offset[v] periods, at image_centre[v]
+// (images 0..n_spheres-1 are the spheres themselves, wrapped into the cell). So the geometry of
+// a cell is read from image_centre as that of an ordinary mesh's from the centres. Across each
+// facet lies another stored cell translated by neighbour_shift periods; mirror gives the local
+// index of this cell in that neighbour. A cell may be its own neighbour (through another
+// period), and two cells may share several facets, which only mirror tells apart.
+#pragma once
+#include <array>
+#include <vector>
+
+#include "triangulation/mesh.hpp"
+#include "triangulation/periodic_cell.hpp"
+#include "triangulation/vec3.hpp"
+
+namespace pfv {
+
+struct PeriodicMesh {
+  // mesh.n_spheres is the number of images: a periodic mesh has no wall vertices, and every
+  // neighbour is a cell (never -1).
+  Mesh mesh;
+  int n_spheres = 0;
+  std::vector<int> image_sphere;
+  std::vector<Offset> image_offset;
+  std::vector<Vec3> image_centre;
+  std::vector<double> image_radius;
+  std::vector<std::array<int, 4>> mirror;
+  std::vector<std::array<Offset, 4>> neighbour_shift;
+  PeriodicCell cell;
+  double margin = 0;  // how far beyond the cell the images reached
+
+  int n_cells() const { return mesh.n_cells(); }
+  int n_images() const { return static_cast<int>(image_sphere.size()); }
+};
+
+}  // namespace pfv

@@ -1,7 +1,7 @@
 """The flow step's two-thread speed-up against the DEM step's, both measured in one process, interleaved.
 
     yade-double -j2 -n -x bench/thread_gain.py [--n=2e5] [--motion=drift|compression] [--kinds=pfv,pfv-multigrid]
-                [--rounds=6] [--json=FILE]
+                [--rounds=6] [--stages] [--json=FILE]
 
 bench/growth.py times one and two threads in separate children; on this virtual machine, whose speed drifts by up
 to 2x between processes, the two children's DEM steps do not see the same machine, and a comparison of the flow
@@ -19,8 +19,10 @@ flow step is the median coupled step minus the mean of the two dry blocks' media
 
 Per round, the flow step's gain (one thread over two) and the DEM step's, measured within seconds of each other,
 and their ratio; printed: the medians over the rounds and their ranges, and the core's stages (Engine.step_times)
-at each thread count. The target of doc/scaling.md is a ratio of at least 1: the flow step gains at least what
-YADE's DEM step gains. No time is asserted anywhere.
+at each thread count. --stages also turns on O.timingEnabled and prints the engine's timing stages (those of YADE's
+timing.stats(): the exchange with YADE and the Python around the core included) per coupled step at each count.
+The target of doc/scaling.md is a ratio of at least 1: the flow step gains at least what YADE's DEM step gains. No
+time is asserted anywhere.
 """
 import json
 import statistics
@@ -48,13 +50,18 @@ def block(flow, motion, threads):
     for _ in range(WARM):
         yade_step()
     coupled, stages = [], []
+    if hasattr(flow, "timingDeltas"):
+        flow.timingDeltas.reset()
     for _ in range(BLOCK):
         coupled.append(yade_step())
         if hasattr(flow, "core"):
             stages.append(dict(flow.core.step_times()))
+    laps = {}
+    if hasattr(flow, "timingDeltas"):
+        laps = {label: ns * 1e-9 / BLOCK for label, ns, _ in flow.timingDeltas.data}
     after = statistics.median(dry_steps(flow, motion, BLOCK))
     dem = 0.5 * (before + after)
-    return statistics.median(coupled) - dem, dem, stages
+    return statistics.median(coupled) - dem, dem, stages, laps
 
 
 def trial(kind, motion, rounds):
@@ -65,17 +72,20 @@ def trial(kind, motion, rounds):
     set_threads(flow, 2)
     for _ in range(FIRST):
         yade_step()
-    out = {1: dict(flow=[], dem=[], stages=[]), 2: dict(flow=[], dem=[], stages=[])}
+    out = {t: dict(flow=[], dem=[], stages=[], laps=[]) for t in (1, 2)}
     for r in range(rounds):
         for threads in (1, 2) if r % 2 == 0 else (2, 1):
-            f, d, stages = block(flow, motion, threads)
+            f, d, stages, laps = block(flow, motion, threads)
             out[threads]["flow"].append(f)
             out[threads]["dem"].append(d)
             out[threads]["stages"] += stages
+            out[threads]["laps"].append(laps)
     rec = dict(kind=kind, rounds=[dict(flow1=out[1]["flow"][r], flow2=out[2]["flow"][r], dem1=out[1]["dem"][r],
                                        dem2=out[2]["dem"][r]) for r in range(rounds)])
     rec["stages"] = {t: {s: statistics.median(st[s] for st in out[t]["stages"]) for s in STAGES}
                      for t in (1, 2) if out[t]["stages"]}
+    rec["laps"] = {t: {k: statistics.median(lp.get(k, 0.0) for lp in out[t]["laps"]) for k in out[t]["laps"][0]}
+                   for t in (1, 2) if out[t]["laps"] and out[t]["laps"][0]}
     if hasattr(flow, "core"):
         rec["solver"] = flow.core.solver_choice
         rec["cg_iterations"] = flow.core.cg_iterations
@@ -99,6 +109,9 @@ def report(rec):
         print(f"  {name:10s} median {med(xs):.2f} (rounds {min(xs):.2f}-{max(xs):.2f})")
     for t, st in rec.get("stages", {}).items():
         print(f"  core at {t} thread(s): " + ", ".join(f"{s} {1e3 * v:.1f} ms" for s, v in st.items()))
+    for t, laps in rec.get("laps", {}).items():
+        print(f"  timing stages at {t} thread(s), per step: "
+              + ", ".join(f"{k} {1e3 * v:.2f} ms" for k, v in laps.items()))
 
 
 def main(argv):
@@ -113,6 +126,7 @@ def main(argv):
     kinds = option(argv, "kinds", "pfv,pfv-multigrid").split(",")
     rounds = int(option(argv, "rounds", "6"))
     motion = build_scene(n, motion_name)
+    O.timingEnabled = bool(option(argv, "stages", False))
     data = dict(n=n, motion=motion_name, trials=[])
     for kind in kinds:
         rec = trial(kind, motion, rounds)

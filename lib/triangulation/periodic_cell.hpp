@@ -7,11 +7,10 @@
 #include <array>
 #include <cmath>
 
+#include "triangulation/mesh.hpp"
 #include "triangulation/vec3.hpp"
 
 namespace pfv {
-
-using Offset = std::array<int, 3>;  // a lattice translation, in periods along each cell vector
 
 struct PeriodicCell {
   Eigen::Matrix3d h = Eigen::Matrix3d::Identity();

@@ -4,9 +4,11 @@
 // images: sphere image_sphere[v] translated by image_offset[v] periods, at image_centre[v]
 // (images 0..n_spheres-1 are the spheres themselves, wrapped into the cell). So the geometry of
 // a cell is read from image_centre as that of an ordinary mesh's from the centres. Across each
-// facet lies another stored cell translated by neighbour_shift periods; mirror gives the local
-// index of this cell in that neighbour. A cell may be its own neighbour (through another
-// period), and two cells may share several facets, which only mirror tells apart.
+// facet lies another stored cell translated by mesh.neighbour_shift periods; mesh.cell_mirror
+// gives the facet's local index in that neighbour: in a thin cell one cell may lie across two
+// facets of another (through two periods), which only the mirror tells apart, and a cell may hold
+// two images of one sphere. (A cell is never its own neighbour: a tetrahedron with two facets
+// that are translates of each other has three collinear vertices.)
 #pragma once
 #include <array>
 #include <vector>
@@ -26,8 +28,6 @@ struct PeriodicMesh {
   std::vector<Offset> image_offset;
   std::vector<Vec3> image_centre;
   std::vector<double> image_radius;
-  std::vector<std::array<int, 4>> mirror;
-  std::vector<std::array<Offset, 4>> neighbour_shift;
   PeriodicCell cell;
   double margin = 0;  // how far beyond the cell the images reached
 

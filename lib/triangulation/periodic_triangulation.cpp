@@ -265,16 +265,16 @@ bool PeriodicTriangulation::try_build(const std::vector<double>& radii, double m
   for (int s = 0; s < n; ++s) add_image({s, {0, 0, 0}});
   out.mesh.cell_vertices.resize(nc);
   out.mesh.cell_neighbours.resize(nc);
-  out.mirror.resize(nc);
-  out.neighbour_shift.resize(nc);
+  out.mesh.cell_mirror.resize(nc);
+  out.mesh.neighbour_shift.resize(nc);
   for (int id = 0; id < nc; ++id) {
     const int i = number[id];
     const auto v = m.images_of(m.kept[id]);
     for (int l = 0; l < 4; ++l) {
       out.mesh.cell_vertices[i][l] = add_image(v[l]);
       out.mesh.cell_neighbours[i][l] = number[neighbour[id][l]];
-      out.mirror[i][l] = mirror[id][l];
-      out.neighbour_shift[i][l] = shift[id][l];
+      out.mesh.cell_mirror[i][l] = mirror[id][l];
+      out.mesh.neighbour_shift[i][l] = shift[id][l];
     }
   }
   for (auto& [key, id] : m.key_to_cell) id = number[id];

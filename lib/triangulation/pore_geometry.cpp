@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "pfv/common/parallel.hpp"
 #include "triangulation/solid_angle.hpp"
@@ -217,6 +218,12 @@ CellGeometry compute_cell_geometry(const Mesh& mesh, const Packing& pk) {
   return g;
 }
 
+Vec3 neighbour_translation(const Mesh& mesh, const Packing& pk, int cell, int local) {
+  if (!mesh.periodic() || pk.period == nullptr) return Vec3::Zero();
+  const Offset& o = mesh.neighbour_shift[cell][local];
+  return *pk.period * Vec3(o[0], o[1], o[2]);
+}
+
 Vec3 facet_area_vector(const Mesh& mesh, const std::array<int, 3>& facet, int opposite, const Packing& pk) {
   const FacetPolygon f = make_polygon(mesh, facet, pk);
   const Vec3 dir = away_from(mesh, f, opposite, pk);
@@ -227,16 +234,23 @@ FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells
                                      bool slip_boundary) {
   FacetGeometry g;
   // Each facet once: from its lower-numbered pore cell, or from its only pore cell.
+  const bool periodic = mesh.periodic();
+  if (periodic && pk.period == nullptr)
+    throw std::invalid_argument("compute_facet_geometry: a periodic mesh needs the packing's period");
   for (int i = 0; i < mesh.n_cells(); ++i)
     for (int l = 0; l < 4; ++l) {
       const int j = mesh.cell_neighbours[i][l];
-      if (j >= 0 && j < i) continue;
       int lj = -1;
-      if (j >= 0)
+      if (periodic) {
+        lj = mesh.cell_mirror[i][l];
+      } else if (j >= 0) {
         for (int m = 0; m < 4; ++m)
           if (mesh.cell_neighbours[j][m] == i) lj = m;
+      }
+      if (j >= 0 && j < i) continue;
       g.cell.push_back({i, j});
       g.local.push_back({l, lj});
+      if (periodic) g.translation.push_back(neighbour_translation(mesh, pk, i, l));
     }
   const int nf = g.size();
   g.vertex.resize(nf);
@@ -290,6 +304,7 @@ FacetGeometry compute_facet_geometry(const Mesh& mesh, const CellGeometry& cells
     int sides = 1;
     if (j >= 0) {
       apex[1] = cells.power_centre[j];
+      if (periodic) apex[1] += g.translation[f];
       height[1] = nrm.dot(apex[1] - x0);
       sides = 2;
       g.length[f] = (apex[1] - Pi).norm();
@@ -342,7 +357,7 @@ int find_facet(const FacetGeometry& g, const Mesh& mesh, int cell, int local) {
                                       [](const std::array<int, 2>& c, int x) { return c[0] < x; });
   for (auto it = first; it != g.cell.end() && (*it)[0] == owner; ++it) {
     const std::size_t f = static_cast<std::size_t>(it - g.cell.begin());
-    if (owner == cell ? g.local[f][0] == local : (g.cell[f][1] == cell && g.local[f][1] == local))
+    if ((g.cell[f][0] == cell && g.local[f][0] == local) || (g.cell[f][1] == cell && g.local[f][1] == local))
       return static_cast<int>(f);
   }
   return -1;

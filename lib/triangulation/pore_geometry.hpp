@@ -49,15 +49,23 @@ struct FacetGeometry {
   std::vector<double> hydraulic_radius;
   std::vector<std::array<double, 3>> sector_area;  // A^k, scaled down if they exceed the facet
   std::vector<std::array<double, 3>> wetted_area;  // gamma^k
+  // Periodic meshes only (else empty): where cell[f][1] lies as seen from cell[f][0], the
+  // translation h * shift of the stored cell (its power centre and vertices move with it).
+  std::vector<Vec3> translation;
 
   int size() const { return static_cast<int>(cell.size()); }
 };
 
 struct Packing {
-  const std::vector<Vec3>& centre;
+  const std::vector<Vec3>& centre;  // per mesh vertex (in a periodic mesh, per image)
   const std::vector<double>& radius;
-  const BoxWalls& walls;
+  const BoxWalls& walls;                    // unused by a periodic mesh
+  const Eigen::Matrix3d* period = nullptr;  // a periodic mesh's cell vectors (periodic_cell.hpp)
 };
+
+// Where the neighbour across facet 'local' of 'cell' lies: the stored cell translated by this
+// (zero but in a periodic mesh).
+Vec3 neighbour_translation(const Mesh& mesh, const Packing& packing, int cell, int local);
 
 CellShape make_cell_shape(const Mesh& mesh, int cell);
 

@@ -9,54 +9,16 @@
 #include <set>
 #include <stdexcept>
 
+#include "periodic_packings.hpp"
 #include "triangulation/periodic_triangulation.hpp"
 
 using namespace pfv;
+using pfv::test::diagonal;
+using pfv::test::periodic_difference;
+using pfv::test::PeriodicPacking;
+using pfv::test::random_periodic;
 
 namespace {
-
-struct PeriodicPacking {
-  std::vector<Vec3> centre;
-  std::vector<double> radius;
-  PeriodicCell cell;
-};
-
-Eigen::Matrix3d diagonal(double a, double b, double c) { return Vec3(a, b, c).asDiagonal(); }
-
-// The shortest vector between the images of x and y (|fractional difference| <= 1/2 on each
-// axis, then the 27 neighbouring images: exact enough for a sheared cell too).
-Vec3 periodic_difference(const PeriodicCell& cell, const Vec3& x, const Vec3& y) {
-  Vec3 f = cell.fractional(x - y);
-  for (int a = 0; a < 3; ++a) f[a] -= std::round(f[a]);
-  Vec3 best = cell.h * f;
-  for (int i = -1; i <= 1; ++i)
-    for (int j = -1; j <= 1; ++j)
-      for (int k = -1; k <= 1; ++k) {
-        const Vec3 d = cell.h * (f + Vec3(i, j, k));
-        if (d.norm() < best.norm()) best = d;
-      }
-  return best;
-}
-
-// Non-overlapping spheres (periodic distances) at random in the cell.
-PeriodicPacking random_periodic(int n, unsigned seed, const Eigen::Matrix3d& h, double rmin, double rmax) {
-  PeriodicPacking p;
-  p.cell.h = h;
-  std::mt19937 gen(seed);
-  std::uniform_real_distribution<double> u(0, 1);
-  while (static_cast<int>(p.centre.size()) < n) {
-    const double r = rmin + (rmax - rmin) * u(gen);
-    const Vec3 x = h * Vec3(u(gen), u(gen), u(gen));
-    bool free = true;
-    for (std::size_t k = 0; k < p.centre.size() && free; ++k)
-      free = periodic_difference(p.cell, x, p.centre[k]).norm() > r + p.radius[k];
-    if (free) {
-      p.centre.push_back(x);
-      p.radius.push_back(r);
-    }
-  }
-  return p;
-}
 
 double cell_volume(const PeriodicMesh& m, int c) {
   const auto& v = m.mesh.cell_vertices[c];
@@ -126,12 +88,12 @@ void expect_periodic_triangulation(const PeriodicMesh& m, const PeriodicPacking&
   // opposite shift, and both see the same three images.
   for (int c = 0; c < m.n_cells(); ++c)
     for (int l = 0; l < 4; ++l) {
-      const int j = m.mesh.cell_neighbours[c][l], lj = m.mirror[c][l];
+      const int j = m.mesh.cell_neighbours[c][l], lj = m.mesh.cell_mirror[c][l];
       ASSERT_TRUE(j >= 0 && j < m.n_cells() && lj >= 0 && lj < 4);
-      const Offset t = m.neighbour_shift[c][l];
+      const Offset t = m.mesh.neighbour_shift[c][l];
       EXPECT_EQ(m.mesh.cell_neighbours[j][lj], c);
-      EXPECT_EQ(m.mirror[j][lj], l);
-      EXPECT_EQ(m.neighbour_shift[j][lj], (Offset{-t[0], -t[1], -t[2]}));
+      EXPECT_EQ(m.mesh.cell_mirror[j][lj], l);
+      EXPECT_EQ(m.mesh.neighbour_shift[j][lj], (Offset{-t[0], -t[1], -t[2]}));
       EXPECT_EQ(facet_images(m, c, l, {0, 0, 0}), facet_images(m, j, lj, t)) << "cell " << c << " facet " << l;
     }
   // Empty orthogonal spheres: no image of any sphere within the two neighbouring periods has a
@@ -182,7 +144,7 @@ TEST(PeriodicTriangulation, OnePeriodOfTheInfiniteTriangulationInAShearedCell) {
 
 TEST(PeriodicTriangulation, DensePolydisperseAndThinCells) {
   // Near the densest random placement of these radii; then a cell one large sphere thick along z,
-  // where a cell meets its own images across that period.
+  // where a cell holds two images of one sphere.
   const auto dense = random_periodic(200, 3, diagonal(1, 1, 1), 0.05, 0.1);
   PeriodicTriangulation tri;
   expect_periodic_triangulation(tri.build(dense.centre, dense.radius, dense.cell), dense);

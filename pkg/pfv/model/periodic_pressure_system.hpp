@@ -1,0 +1,61 @@
+// The pressure of a periodic packing under a macroscopic gradient (thesis 3.5 on the infinite
+// periodic packing): p(x) = p~(x) + gradP . x with p~ periodic, one value p~_i per stored cell.
+//
+// A throat f from cell i to the translate of cell j by t_f (FacetGeometry::translation) carries
+//   q_f = k_f (p_i - p_j') = k_f (p~_i - p~_j - gradP . (P_j + t_f - P_i)),
+// P the power centres, so the balance of each cell, sum_f q_f = -dV_i/dt, reads
+//   G p~ = -dV/dt + s,   s_i = sum_f k_f gradP . d_f (d_f = P_j + t_f - P_i, from i's side).
+// G over all cells annihilates constants: p~ is defined up to one, and the system has a solution
+// only if the sources add up to zero (no net volume change of the pores, the sums of s cancel by
+// construction). The constant is fixed by p~ = 0 in one reference cell, which removes that cell's
+// row and column; what remains is positive definite (the cells are connected).
+//
+// Cells whose power centres coincide (a throat of zero length: cospherical spheres, as in the
+// regular arrays) are one pore cut by arbitrary facets, and share one unknown: their throats have
+// no length, so no finite conductance is right for them. (Clamping them to 100 times the median,
+// as the walled engine and YADE do, makes the simple cubic array 1 % anisotropic and 3 % less
+// permeable than the same pores joined.)
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "pfv/linalg/symmetric_matrix.hpp"
+#include "triangulation/mesh.hpp"
+#include "triangulation/pore_geometry.hpp"
+
+namespace pfv {
+
+struct PeriodicPressureSystem {
+  int reference_cell = 0;         // p~ = 0 there (and in the cells of its pore)
+  std::vector<int> unknown;       // per cell, its pore's unknown; -1 for the reference pore
+  std::vector<int> unknown_cell;  // per unknown, one cell of its pore
+  std::shared_ptr<const SymmetricMatrix> matrix = std::make_shared<const SymmetricMatrix>();
+
+  int n_unknowns() const { return static_cast<int>(unknown_cell.size()); }
+  // The right-hand side of the unknowns from per-cell values: the sum over each pore's cells.
+  std::vector<double> gather(const std::vector<double>& per_cell) const;
+  // Per cell, its pore's value of x (0 in the reference pore).
+  std::vector<double> scatter(const std::vector<double>& x) const;
+};
+
+// facets from compute_facet_geometry of a periodic mesh (translations set); k per facet, the
+// zero-length throats' values unused.
+PeriodicPressureSystem assemble_periodic_system(const Mesh& mesh, const FacetGeometry& facets,
+                                                const std::vector<double>& k);
+
+// Per cell, s_i of the gradient (above).
+std::vector<double> gradient_source(const CellGeometry& cells, const FacetGeometry& facets,
+                                    const std::vector<double>& k, const Vec3& gradient);
+
+// Per facet, the flux q_f from cell[f][0] to cell[f][1]'s translate, for the periodic part p~
+// per cell.
+std::vector<double> periodic_fluxes(const CellGeometry& cells, const FacetGeometry& facets,
+                                    const std::vector<double>& k, const std::vector<double>& periodic_pressure,
+                                    const Vec3& gradient);
+
+// The superficial (Darcy) velocity of the periodic cell of volume V: (1/V) sum_f q_f d_f, the
+// flux through any section of the cell per unit area, averaged over the sections.
+Vec3 mean_velocity(const CellGeometry& cells, const FacetGeometry& facets, const std::vector<double>& fluxes,
+                   double volume);
+
+}  // namespace pfv

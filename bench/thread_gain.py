@@ -80,12 +80,21 @@ def trial(kind, motion, rounds):
             out[threads]["dem"].append(d)
             out[threads]["stages"] += stages
             out[threads]["laps"].append(laps)
-    rec = dict(kind=kind, rounds=[dict(flow1=out[1]["flow"][r], flow2=out[2]["flow"][r], dem1=out[1]["dem"][r],
-                                       dem2=out[2]["dem"][r]) for r in range(rounds)])
-    rec["stages"] = {t: {s: statistics.median(st[s] for st in out[t]["stages"]) for s in STAGES}
-                     for t in (1, 2) if out[t]["stages"]}
-    rec["laps"] = {t: {k: statistics.median(lp.get(k, 0.0) for lp in out[t]["laps"]) for k in out[t]["laps"][0]}
-                   for t in (1, 2) if out[t]["laps"] and out[t]["laps"][0]}
+    rec = dict(
+        kind=kind,
+        rounds=[
+            dict(flow1=out[1]["flow"][r], flow2=out[2]["flow"][r], dem1=out[1]["dem"][r], dem2=out[2]["dem"][r])
+            for r in range(rounds)
+        ],
+    )
+    rec["stages"] = {
+        t: {s: statistics.median(st[s] for st in out[t]["stages"]) for s in STAGES} for t in (1, 2) if out[t]["stages"]
+    }
+    rec["laps"] = {
+        t: {k: statistics.median(lp.get(k, 0.0) for lp in out[t]["laps"]) for k in out[t]["laps"][0]}
+        for t in (1, 2)
+        if out[t]["laps"] and out[t]["laps"][0]
+    }
     if hasattr(flow, "core"):
         rec["solver"] = flow.core.solver_choice
         rec["cg_iterations"] = flow.core.cg_iterations
@@ -103,15 +112,19 @@ def report(rec):
     ratio = [f / d for f, d in zip(flow_gain, dem_gain)]
     print(f"thread_gain: {rec['kind']}" + (f" ({rec['solver']})" if "solver" in rec else ""))
     for name, one, two in (("flow step", "flow1", "flow2"), ("DEM step", "dem1", "dem2")):
-        print(f"  {name:10s} 1 thread {1e3 * med(r[one] for r in rounds):8.1f} ms, "
-              f"2 threads {1e3 * med(r[two] for r in rounds):8.1f} ms")
+        print(
+            f"  {name:10s} 1 thread {1e3 * med(r[one] for r in rounds):8.1f} ms, "
+            f"2 threads {1e3 * med(r[two] for r in rounds):8.1f} ms"
+        )
     for name, xs in (("flow gain", flow_gain), ("DEM gain", dem_gain), ("flow / DEM", ratio)):
         print(f"  {name:10s} median {med(xs):.2f} (rounds {min(xs):.2f}-{max(xs):.2f})")
     for t, st in rec.get("stages", {}).items():
         print(f"  core at {t} thread(s): " + ", ".join(f"{s} {1e3 * v:.1f} ms" for s, v in st.items()))
     for t, laps in rec.get("laps", {}).items():
-        print(f"  timing stages at {t} thread(s), per step: "
-              + ", ".join(f"{k} {1e3 * v:.2f} ms" for k, v in laps.items()))
+        print(
+            f"  timing stages at {t} thread(s), per step: "
+            + ", ".join(f"{k} {1e3 * v:.2f} ms" for k, v in laps.items())
+        )
 
 
 def main(argv):

@@ -31,7 +31,7 @@ def around_flow(flow):
         + [PyRunner(command="record('before')", iterPeriod=1, initRun=True)]
         + [flow]
         + [PyRunner(command="record('after')", iterPeriod=1, initRun=True)]
-        + engines[i + 1:]
+        + engines[i + 1 :]
     )
 
 

@@ -24,6 +24,9 @@ struct PeriodicMesh {
   // neighbour is a cell (never -1).
   Mesh mesh;
   int n_spheres = 0;
+  // Per sphere, the periods that wrapped its centre into the cell: image v of sphere s lies at
+  // centre[s] + h (wrap[s] + image_offset[v]), which follows the sphere as it moves.
+  std::vector<Offset> wrap;
   std::vector<int> image_sphere;
   std::vector<Offset> image_offset;
   std::vector<Vec3> image_centre;

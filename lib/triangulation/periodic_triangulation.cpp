@@ -65,6 +65,7 @@ struct PeriodicTriangulation::Impl {
   std::vector<RT::Cell_handle> kept;                          // per kept cell, before the renumbering
   std::unordered_map<CellKey, int, CellKeyHash> key_to_cell;  // kept cells, final numbers
   std::vector<Vec3> wrapped;                                  // the centres wrapped into the cell
+  std::vector<Offset> wrap;                                   // by these periods
   std::vector<Vec3> fractional;
   PeriodicCell cell;
   Eigen::Matrix3d h_inverse;
@@ -104,19 +105,19 @@ const PeriodicMesh& PeriodicTriangulation::build(const std::vector<Vec3>& centre
   m.cell = cell;
   m.h_inverse = cell.h.inverse();
   m.wrapped.resize(n);
+  m.wrap.resize(n);
   m.fractional.resize(n);
   double r_max = 0;
   for (int k = 0; k < n; ++k) {
     if (!centres[k].allFinite() || !(radii[k] > 0) || !std::isfinite(radii[k]))
       throw std::invalid_argument("periodic triangulation: sphere " + std::to_string(k) +
                                   " has a non-finite centre or a radius that is not positive");
-    Vec3 f = m.h_inverse * centres[k];
-    for (int a = 0; a < 3; ++a) {
-      f[a] -= std::floor(f[a]);
-      if (f[a] >= 1.0) f[a] = 0.0;  // -tiny wrapped to 1 by round-off
-    }
-    m.fractional[k] = f;
-    m.wrapped[k] = cell.h * f;
+    const Vec3 f = m.h_inverse * centres[k];
+    for (int a = 0; a < 3; ++a) m.wrap[k][a] = -static_cast<int>(std::floor(f[a]));
+    // The wrapped centre is the centre moved by whole periods (not h times the fractional
+    // part): the same translation at every step, so the images follow the spheres exactly.
+    m.wrapped[k] = centres[k] + cell.translation(m.wrap[k]);
+    m.fractional[k] = m.h_inverse * m.wrapped[k];
     r_max = std::max(r_max, radii[k]);
   }
   m.max_weight = r_max * r_max;
@@ -249,6 +250,7 @@ bool PeriodicTriangulation::try_build(const std::vector<double>& radii, double m
 
   PeriodicMesh out;
   out.n_spheres = n;
+  out.wrap = m.wrap;
   out.cell = cell;
   out.margin = margin;
   std::unordered_map<Image, int, ImageHash> image_index;

@@ -2,6 +2,7 @@
 #pragma once
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "triangulation/periodic_cell.hpp"
@@ -38,7 +39,8 @@ inline PeriodicPacking random_periodic(int n, unsigned seed, const Eigen::Matrix
   p.cell.h = h;
   std::mt19937 gen(seed);
   std::uniform_real_distribution<double> u(0, 1);
-  while (static_cast<int>(p.centre.size()) < n) {
+  for (long attempt = 0; static_cast<int>(p.centre.size()) < n; ++attempt) {
+    if (attempt > 1000000) throw std::runtime_error("random_periodic: no room for the spheres asked for");
     const double r = rmin + (rmax - rmin) * u(gen);
     const Vec3 x = h * Vec3(u(gen), u(gen), u(gen));
     bool free = true;

@@ -8,6 +8,7 @@
 #include "periodic_packings.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/model/conductance.hpp"
+#include "pfv/model/periodic_forces.hpp"
 #include "pfv/model/periodic_pressure_system.hpp"
 #include "triangulation/periodic_triangulation.hpp"
 
@@ -26,6 +27,7 @@ struct Darcy {
   PeriodicPressureSystem system;
   Mesh mesh;
   Vec3 velocity;
+  std::vector<Vec3> force;  // per sphere
 };
 
 Darcy solve(const PeriodicPacking& p, const Vec3& gradient) {
@@ -48,6 +50,11 @@ Darcy solve(const PeriodicPacking& p, const Vec3& gradient) {
   d.periodic_pressure = d.system.scatter(x);
   d.flux = periodic_fluxes(cells, d.facets, k, d.periodic_pressure, gradient);
   d.velocity = mean_velocity(cells, d.facets, d.flux, p.cell.volume());
+  ForceCache cache;
+  cache.build(m.mesh, d.facets, pk);
+  PeriodicForces forces;
+  forces.build(cache, m);
+  d.force = forces.apply(cache, m, full_pressure(cells, d.periodic_pressure, gradient), gradient, m.cell.h);
   d.mesh = m.mesh;
   return d;
 }
@@ -89,6 +96,40 @@ TEST(PeriodicPermeability, EveryPoreConservesTheFluid) {
   for (std::size_t c = 0; c < out.size(); ++c) EXPECT_NEAR(out[c], 0.0, 1e-9 * largest) << "cell " << c;
   // The flow goes down the gradient.
   EXPECT_LT(d.velocity.dot(Vec3(0.3, -1.0, 0.2)), 0);
+}
+
+TEST(PeriodicPermeability, TheFluidPushesTheSolidWithTheGradientTimesTheVolume) {
+  // Static spheres: the fluid's momentum balance over one period, sum F = -gradP V, holds in the
+  // model exactly (closed cells, and sum_f d_f (x) S_f = V I over the throats of a tiling).
+  Eigen::Matrix3d h = diagonal(1, 1.1, 0.95);
+  h(0, 2) = 0.3;
+  for (const auto& p :
+       {random_periodic(120, 33, h, 0.05, 0.1), random_periodic(90, 34, diagonal(1, 1, 1), 0.08, 0.1)}) {
+    const Vec3 gradient(0.4, -1.0, 0.7);
+    const Darcy d = solve(p, gradient);
+    Vec3 total = Vec3::Zero();
+    double largest = 0;
+    for (const Vec3& f : d.force) {
+      total += f;
+      largest = std::max(largest, f.norm());
+    }
+    const Vec3 expected = -gradient * p.cell.volume();
+    EXPECT_LT((total - expected).norm(), 1e-8 * expected.norm()) << total.transpose() << " vs " << expected.transpose();
+    EXPECT_GT(largest, 0.1 * expected.norm() / p.centre.size());
+  }
+}
+
+TEST(PeriodicPermeability, ShiftingEverySphereChangesNoForce) {
+  const auto p = random_periodic(80, 35, diagonal(1.1, 1, 0.9), 0.05, 0.1);
+  const Vec3 gradient(0, 0, -2.0);
+  const Darcy d = solve(p, gradient);
+  PeriodicPacking moved = p;
+  for (Vec3& x : moved.centre) x += Vec3(-0.21, 0.64, 0.33);
+  const Darcy e = solve(moved, gradient);
+  double largest = 0;
+  for (const Vec3& f : d.force) largest = std::max(largest, f.norm());
+  for (std::size_t s = 0; s < p.centre.size(); ++s)
+    EXPECT_LT((d.force[s] - e.force[s]).norm(), 1e-8 * largest) << "sphere " << s;
 }
 
 TEST(PeriodicPermeability, CellsOfOnePoreShareTheirPressure) {

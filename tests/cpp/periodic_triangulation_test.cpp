@@ -78,6 +78,9 @@ void expect_periodic_triangulation(const PeriodicMesh& m, const PeriodicPacking&
     }
     EXPECT_LT((m.image_centre[v] - wrapped - p.cell.translation(m.image_offset[v])).norm(), 1e-12);
     EXPECT_LT(periodic_difference(p.cell, wrapped, p.centre[s]).norm(), 1e-12);
+    Offset o = m.image_offset[v];
+    for (int a = 0; a < 3; ++a) o[a] += m.wrap[s][a];
+    EXPECT_LT((m.image_centre[v] - p.centre[s] - p.cell.translation(o)).norm(), 1e-12);
     EXPECT_EQ(m.image_radius[v], p.radius[s]);
   }
   // The cells tile one period.
@@ -169,7 +172,9 @@ TEST(PeriodicTriangulation, CentresOutsideTheCellAreWrapped) {
   std::mt19937 gen(6);
   std::uniform_int_distribution<int> period(-3, 3);
   for (Vec3& x : p.centre) x += p.cell.translation({period(gen), period(gen), period(gen)});
-  expect_same_volumes(reference, sorted_volumes(tri.build(p.centre, p.radius, p.cell)), 1.0 / p.centre.size());
+  const PeriodicMesh& m = tri.build(p.centre, p.radius, p.cell);
+  expect_same_volumes(reference, sorted_volumes(m), 1.0 / p.centre.size());
+  expect_periodic_triangulation(m, p);
 }
 
 TEST(PeriodicTriangulation, ShiftingEverySphereChangesNoCell) {

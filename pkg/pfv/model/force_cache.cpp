@@ -6,6 +6,30 @@
 #include "pfv/model/force_terms.hpp"
 
 namespace pfv {
+namespace {
+
+// The local index in cell[f][side] of facet vertex v (a vertex of cell[f][0]): v itself, but in
+// the far cell of a periodic mesh, where the facet's vertices are other images of the same
+// spheres, the vertex that the facet's translation carries onto v.
+int local_of(const Mesh& mesh, const FacetGeometry& facets, const Packing& packing, int f, int side, int v) {
+  const int c = facets.cell[f][side];
+  if (side == 0 || facets.translation.empty()) {
+    for (int l = 0; l < 4; ++l)
+      if (mesh.cell_vertices[c][l] == v) return l;
+    return -1;
+  }
+  const Vec3 x = packing.centre[v] - facets.translation[f];
+  int best = -1;
+  double nearest = 0;
+  for (int l = 0; l < 4; ++l) {
+    if (l == facets.local[f][1]) continue;
+    const double d = (packing.centre[mesh.cell_vertices[c][l]] - x).squaredNorm();
+    if (best < 0 || d < nearest) best = l, nearest = d;
+  }
+  return best;
+}
+
+}  // namespace
 
 void ForceCache::build(const Mesh& mesh, const FacetGeometry& facets, const Packing& packing) {
   const int nc = mesh.n_cells();
@@ -24,9 +48,8 @@ void ForceCache::build(const Mesh& mesh, const FacetGeometry& facets, const Pack
       if (c < 0) continue;
       const double sign = side == 0 ? 1.0 : -1.0;  // n points out of cell 0
       for (int s = 0; s < 3; ++s) {
-        const int v = facets.vertex[f][s];
-        for (int l = 0; l < 4; ++l)
-          if (mesh.cell_vertices[c][l] == v) per_cell[c][l] += sign * coef[s] * n;
+        const int l = local_of(mesh, facets, packing, f, side, facets.vertex[f][s]);
+        if (l >= 0) per_cell[c][l] += sign * coef[s] * n;
       }
     }
   }

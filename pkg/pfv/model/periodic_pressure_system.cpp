@@ -42,11 +42,14 @@ std::vector<double> PeriodicPressureSystem::scatter(const std::vector<double>& x
 }
 
 PeriodicPressureSystem assemble_periodic_system(const Mesh& mesh, const FacetGeometry& facets,
-                                                const std::vector<double>& k) {
+                                                const std::vector<double>& k, const std::vector<double>& storage) {
   require_periodic(facets, k, "assemble_periodic_system");
   const int n = mesh.n_cells();
   if (n < 1) throw std::invalid_argument("assemble_periodic_system: no cells");
+  if (!storage.empty() && static_cast<int>(storage.size()) != n)
+    throw std::invalid_argument("assemble_periodic_system: one storage value per cell is needed");
   PeriodicPressureSystem s;
+  if (!storage.empty()) s.reference_cell = -1;
   // Pores: the cells joined by zero-length throats.
   std::vector<int> parent(n);
   for (int c = 0; c < n; ++c) parent[c] = c;
@@ -54,7 +57,7 @@ PeriodicPressureSystem assemble_periodic_system(const Mesh& mesh, const FacetGeo
     if (facets.length[f] == 0) parent[find_root(parent, facets.cell[f][0])] = find_root(parent, facets.cell[f][1]);
   s.unknown.assign(n, -1);
   std::vector<int> root_unknown(n, -1);
-  const int reference_root = find_root(parent, s.reference_cell);
+  const int reference_root = s.reference_cell < 0 ? -1 : find_root(parent, s.reference_cell);
   for (int c = 0; c < n; ++c) {
     const int r = find_root(parent, c);
     if (r == reference_root) continue;
@@ -78,6 +81,8 @@ PeriodicPressureSystem assemble_periodic_system(const Mesh& mesh, const FacetGeo
     if (ua >= 0 && ub >= 0)
       entries.emplace_back(static_cast<long long>(std::max(ua, ub)) * m + std::min(ua, ub), -k[f]);
   }
+  if (!storage.empty())
+    for (int c = 0; c < n; ++c) diagonal[s.unknown[c]] += storage[c];
   for (int u = 0; u < m; ++u) entries.emplace_back(static_cast<long long>(u) * m + u, diagonal[u]);
   std::sort(entries.begin(), entries.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   auto g = std::make_shared<SymmetricMatrix>();

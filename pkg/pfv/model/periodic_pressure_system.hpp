@@ -26,7 +26,7 @@
 namespace pfv {
 
 struct PeriodicPressureSystem {
-  int reference_cell = 0;         // p~ = 0 there (and in the cells of its pore)
+  int reference_cell = 0;         // p~ = 0 there (and in the cells of its pore); -1: none
   std::vector<int> unknown;       // per cell, its pore's unknown; -1 for the reference pore
   std::vector<int> unknown_cell;  // per unknown, one cell of its pore
   std::shared_ptr<const SymmetricMatrix> matrix = std::make_shared<const SymmetricMatrix>();
@@ -39,9 +39,11 @@ struct PeriodicPressureSystem {
 };
 
 // facets from compute_facet_geometry of a periodic mesh (translations set); k per facet, the
-// zero-length throats' values unused.
+// zero-length throats' values unused. storage (optional, per cell, > 0): V_f / (K dt) of a
+// compressible fluid, added to the diagonal; G is then positive definite and no pore is the
+// reference (reference_cell -1).
 PeriodicPressureSystem assemble_periodic_system(const Mesh& mesh, const FacetGeometry& facets,
-                                                const std::vector<double>& k);
+                                                const std::vector<double>& k, const std::vector<double>& storage = {});
 
 // Per cell, s_i of the gradient (above).
 std::vector<double> gradient_source(const CellGeometry& cells, const FacetGeometry& facets,

@@ -1,0 +1,92 @@
+// The flow through a periodic packing, one DEM step at a time (the engine of
+// pfv.PeriodicFlowEngine): the periodic regular triangulation (periodic_triangulation.hpp), its
+// pores and throats, the system G p~ = -dV/dt + s of periodic_pressure_system.hpp under the
+// imposed macroscopic gradient, and the forces of periodic_forces.hpp.
+//
+// As the walled engine: the mesh, conductances, G and its factor are made at a remesh and kept;
+// each step measures the cells' volumes at the spheres' positions and the cell's current
+// vectors (the images follow both, so a homogeneous deformation of the cell, shear included,
+// enters dV/dt), solves and applies the force cache. With a compressible fluid (bulk modulus K >
+// 0) each pore stores V_f / (K dt) per unit pressure, G + that storage is positive definite, and
+// p~ is absolute; incompressible, p~ = 0 in one reference pore (and a net change of the pores'
+// volume has nowhere to go: the reference pore absorbs it).
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "pfv/linalg/pressure_solver.hpp"
+#include "pfv/model/force_cache.hpp"
+#include "pfv/model/periodic_forces.hpp"
+#include "pfv/model/periodic_pressure_system.hpp"
+#include "triangulation/periodic_triangulation.hpp"
+#include "triangulation/pore_geometry.hpp"
+
+namespace pfv {
+
+struct PeriodicFlowSettings {
+  double viscosity = 1.0;
+  double permeability_factor = 1.0;
+  Vec3 gradient = Vec3::Zero();  // gradP, the imposed macroscopic pressure gradient
+  double bulk_modulus = 0.0;     // of the fluid; 0: incompressible
+
+  // Throws std::invalid_argument naming the setting that is not finite or out of range.
+  void validate() const;
+};
+
+class PeriodicFlow {
+ public:
+  // A cell thinner than this many of the largest sphere diameters along a period is refused:
+  // a sphere would reach across half of it, and the pores would be those of a few spheres and
+  // their own images rather than of a packing (YADE's collider refuses such cells too unless
+  // allowBiggerThanPeriod).
+  static constexpr double kMinWidthInDiameters = 2.0;
+
+  PeriodicFlow();
+  ~PeriodicFlow();
+
+  // The settings take effect at the next step (a change of viscosity, permeability factor or
+  // bulk modulus rebuilds G there, without a remesh). Throws std::invalid_argument as validate().
+  void set_settings(const PeriodicFlowSettings& settings);
+  const PeriodicFlowSettings& settings() const { return settings_; }
+
+  // Asks for a new mesh at the next step.
+  void request_remesh() { remesh_due_ = true; }
+  bool has_mesh() const { return mesh_ != nullptr; }
+
+  // One step of length dt with the spheres at centres (anywhere, unwrapped) and the cell's
+  // vectors h: remesh if due (radii are read then), dV/dt from the last step's positions, solve,
+  // forces. Throws std::invalid_argument on bad input before anything changes.
+  void step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const Eigen::Matrix3d& h, double dt);
+
+  const PeriodicMesh& mesh() const;
+  // Per stored cell: p~, the full pressure p~ + gradP . P, dV/dt.
+  const std::vector<double>& periodic_pressure() const { return periodic_pressure_; }
+  std::vector<double> pressure() const;
+  const std::vector<double>& volume_rates() const { return volume_rate_; }
+  const std::vector<Vec3>& forces() const { return force_; }  // per sphere
+  // The superficial velocity (1/V) sum_f q_f d_f.
+  Vec3 mean_velocity() const;
+  // The pressure p~ + gradP . x at x (anywhere), or NaN before the first step.
+  double pressure_at(const Vec3& x) const;
+  int remesh_count() const { return remeshes_; }
+  // Per stored cell, its fluid volume at the remesh (what the storage of a compressible fluid uses).
+  const std::vector<double>& fluid_volumes() const;
+
+ private:
+  struct Mesh;
+  void remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const Eigen::Matrix3d& h);
+  void build_system(double dt);
+  void image_positions(const std::vector<Vec3>& centres, const Eigen::Matrix3d& h, std::vector<Vec3>& out) const;
+
+  PeriodicFlowSettings settings_;
+  std::unique_ptr<Mesh> mesh_;
+  bool remesh_due_ = true, system_due_ = true, has_previous_ = false;
+  double system_dt_ = 0;
+  int remeshes_ = 0;
+  Eigen::Matrix3d h_ = Eigen::Matrix3d::Identity();
+  std::vector<Vec3> centres_, images_;  // the last step's
+  std::vector<double> volume_, volume_rate_, periodic_pressure_, storage_;
+  std::vector<Vec3> force_;
+};
+
+}  // namespace pfv

@@ -183,8 +183,12 @@ void PeriodicFlow::build_system(double dt) {
   mesh.system = assemble_periodic_system(mesh.periodic().mesh, mesh.facets, mesh.conductance, storage_);
   mesh.solver.reset();
   if (mesh.system.n_unknowns() > 0) {
+    // METIS orders the periodic graph as it is; the geometric dissection cuts by planes, which
+    // the pores' graph crosses through every period.
+    SolverOptions options;
+    options.factor.ordering = Ordering::kMetis;
     mesh.solver = std::make_unique<CholeskySolver>();
-    mesh.solver->setup(mesh.system.matrix, SolverOptions{});
+    mesh.solver->setup(mesh.system.matrix, options);
   }
   system_dt_ = dt;
   system_due_ = false;

@@ -155,6 +155,7 @@ PYBIND11_MODULE(_core, m) {
 
   // The code that reads YADE's objects in place (pfv/yade_bridge/).
   bind_yade_bridge(m);
+  bind_periodic(m);
 
   // One axis of the sphere centres straight from YADE's coordinate list for that axis
   // (yade._utils.coordsAndDisplacements(axis)[0], all bodies): no numpy round trip. One axis at

@@ -144,5 +144,6 @@ void bind_persistence(EngineClass& engine);  // persistence_bindings.cpp
 void bind_cells(EngineClass& engine);        // cell_bindings.cpp
 // The module's YADE bridge classes and functions (yade_bridge_bindings.cpp).
 void bind_yade_bridge(py::module_& m);
+void bind_periodic(py::module_& m);  // periodic_bindings.cpp
 
 }  // namespace pfv::python

@@ -1,0 +1,64 @@
+// pfv._core.PeriodicFlow: the step of a periodic cell (engine/periodic_flow.hpp) for Python, with
+// numpy arrays in and out. A step releases the GIL while it runs.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include "pfv/engine/periodic_flow.hpp"
+#include "pfv/python/shared_engine.hpp"
+
+namespace pfv::python {
+
+namespace {
+
+Eigen::Matrix3d to_cell(const Array& h) {
+  if (h.ndim() != 2 || h.shape(0) != 3 || h.shape(1) != 3) throw py::value_error("h must have shape (3, 3)");
+  Eigen::Matrix3d out;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out(i, j) = h.at(i, j);
+  return out;
+}
+
+}  // namespace
+
+void bind_periodic(py::module_& m) {
+  py::class_<PeriodicFlow>(m, "PeriodicFlow",
+                           "The flow through a periodic packing under an imposed mean pressure gradient, one DEM step "
+                           "at a time (p = p~ + gradP . x, p~ periodic).")
+      .def(py::init<>())
+      .def(
+          "set_settings",
+          [](PeriodicFlow& f, double viscosity, double permeability_factor, const Vec3& gradient, double bulk_modulus) {
+            PeriodicFlowSettings s;
+            s.viscosity = viscosity;
+            s.permeability_factor = permeability_factor;
+            s.gradient = gradient;
+            s.bulk_modulus = bulk_modulus;
+            f.set_settings(s);
+          },
+          py::arg("viscosity"), py::arg("permeability_factor"), py::arg("gradient"), py::arg("bulk_modulus"))
+      .def(
+          "step",
+          [](PeriodicFlow& f, const Array& centres, const Array& radii, const Array& h, double dt) {
+            const auto c = to_points(centres, "centres");
+            const auto r = to_vector(radii, "radii");
+            const Eigen::Matrix3d cell = to_cell(h);
+            py::gil_scoped_release release;
+            f.step(c, r, cell, dt);
+          },
+          py::arg("centres"), py::arg("radii"), py::arg("h"), py::arg("dt"),
+          "One step: centres (n, 3), radii (n,), the cell's vectors h (3, 3, columns as YADE's hSize), dt.")
+      .def("request_remesh", &PeriodicFlow::request_remesh)
+      .def("has_mesh", &PeriodicFlow::has_mesh)
+      .def_property_readonly("remesh_count", &PeriodicFlow::remesh_count)
+      .def_property_readonly("n_cells", [](const PeriodicFlow& f) { return f.has_mesh() ? f.mesh().n_cells() : 0; })
+      .def("periodic_pressure", [](const PeriodicFlow& f) { return vector_to_array(f.periodic_pressure()); })
+      .def("pressure", [](const PeriodicFlow& f) { return vector_to_array(f.pressure()); })
+      .def("volume_rates", [](const PeriodicFlow& f) { return vector_to_array(f.volume_rates()); })
+      .def("fluid_volumes", [](const PeriodicFlow& f) { return vector_to_array(f.fluid_volumes()); })
+      .def("forces", [](const PeriodicFlow& f) { return points_to_array(f.forces()); })
+      .def("mean_velocity", &PeriodicFlow::mean_velocity)
+      .def("pressure_at", &PeriodicFlow::pressure_at, py::arg("x"));
+}
+
+}  // namespace pfv::python

@@ -1,0 +1,147 @@
+"""PFV's periodic flow (pfv._core.PeriodicFlow) beside YADE's PeriodicFlowEngine, and where YADE's cannot run.
+
+    yade-double -n -x tests/yade/flow/test_periodic_vs_yade.py        (exit 0 = pass)
+
+1. Simple cubic array, radius 0.4995, spacing 1, 6 x 6 x 6 spheres, centres jittered by up to 1e-4 (YADE's engine
+   gives NaN on the exact, cospherical array), gradP = (0, 1, 0), viscosity 1: the same positions in both engines.
+   Both implement the thesis' hydraulic-radius model; they differ in how they clamp the near-zero-length throats
+   inside each cube of the lattice (PFV: 100 x the median conductance, YADE: relative to the mean), which moves the
+   permeability by a fraction of a per cent (measured: PFV 2.4878e-3, YADE 2.4933e-3). Checked: kappa within 1 %,
+   every sphere's force within 1 % of its magnitude, and PFV's total force -gradP V to 1e-8.
+2. The exact array: PFV joins the cells of each cube into one pore (zero-length throats), which makes it isotropic
+   and 0.3 % below Zick & Homsy (1982): kappa = 2 a^2 / (9 c K) = 2.52e-3 (c = 0.5236, K = 42.14); checked within 1 %
+   and along x, y, z to 1e-9.
+3. The same array in a cell sheared by one spacing (O.cell.hSize with an off-diagonal 6: the same lattice), where
+   YADE's engine reports "periodicity is broken" and crashes: PFV gives the unsheared kappa to 1e-8.
+4. A dense random periodic packing made by YADE's own pack.randomPeriPack (297 spheres, solid fraction 0.62; YADE's
+   engine fails on these with locateCell errors): PFV's total force is -gradP V to 1e-8, its kappa is positive, and
+   the packing tiled 2 x 2 x 2 (a cell twice as large, eight copies) gives the same kappa to 1e-8.
+"""
+import numpy as np
+
+from pfv_testing import checks
+from yade import O, utils, pack  # noqa: E402
+from yade.minieigenHP import Matrix3, Vector3  # noqa: E402
+from yade.wrapper import (  # noqa: E402
+    Bo1_Sphere_Aabb,
+    ForceResetter,
+    Ig2_Sphere_Sphere_ScGeom,
+    InsertionSortCollider,
+    InteractionLoop,
+    Ip2_FrictMat_FrictMat_FrictPhys,
+    Law2_ScGeom_FrictPhys_CundallStrack,
+    NewtonIntegrator,
+    PeriodicFlowEngine,
+)
+import pfv._core as core  # noqa: E402
+
+SIDE, RADIUS, JITTER = 6, 0.4995, 1e-4
+GRADIENT = (0.0, 1.0, 0.0)
+ZICK_HOMSY = 2.0 * 0.5**2 / (9 * 0.5236 * 42.14)
+
+
+def cell_matrix():
+    return np.array([[O.cell.hSize[i, j] for j in range(3)] for i in range(3)])
+
+
+def pfv_flow(centres, radii, h, gradient=GRADIENT):
+    flow = core.PeriodicFlow()
+    flow.set_settings(viscosity=1.0, permeability_factor=1.0, gradient=gradient, bulk_modulus=0.0)
+    flow.step(np.asarray(centres, dtype=float), np.asarray(radii, dtype=float), h, 1e-5)
+    return flow
+
+
+def lattice(jitter, seed=5):
+    rng = np.random.default_rng(seed)
+    grid = np.array([[i + 0.5, j + 0.5, k + 0.5] for i in range(SIDE) for j in range(SIDE) for k in range(SIDE)])
+    return grid + (rng.uniform(-jitter, jitter, grid.shape) if jitter else 0.0)
+
+
+# 1. Side by side on the jittered array.
+O.periodic = True
+O.cell.hSize = Matrix3(SIDE, 0, 0, 0, SIDE, 0, 0, 0, SIDE)
+centres = lattice(JITTER)
+for c in centres:
+    O.bodies.append(utils.sphere(tuple(c), RADIUS, fixed=True))
+yade_flow = PeriodicFlowEngine(gradP=Vector3(*GRADIENT), viscosity=1.0, useSolver=3)
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb()], allowBiggerThanPeriod=True),
+    InteractionLoop(
+        [Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()], [Law2_ScGeom_FrictPhys_CundallStrack()]
+    ),
+    yade_flow,
+    NewtonIntegrator(),
+]
+O.dt = 1e-5
+O.step()
+O.step()
+yade_kappa = -yade_flow.averageVelocity()[1]
+yade_force = np.array([tuple(O.forces.f(i)) for i in range(len(centres))])
+radii = np.full(len(centres), RADIUS)
+ours = pfv_flow(centres, radii, cell_matrix())
+kappa = -ours.mean_velocity()[1]
+print(f"simple cubic, jittered: kappa PFV {kappa:.6g}, YADE {yade_kappa:.6g}, Zick & Homsy {ZICK_HOMSY:.6g}")
+checks.check(
+    "jittered array: kappa within 1 % of YADE's", abs(kappa / yade_kappa - 1) < 0.01, f"{kappa} vs {yade_kappa}"
+)
+force = ours.forces()
+scale = np.linalg.norm(yade_force, axis=1)
+worst = float((np.linalg.norm(force - yade_force, axis=1) / scale).max())
+checks.check("jittered array: every sphere's force within 1 % of YADE's", worst < 0.01, f"worst {worst:.2e}")
+volume = SIDE**3
+total = force.sum(axis=0)
+checks.check(
+    "jittered array: PFV's total force is -gradP V",
+    np.abs(total + np.array(GRADIENT) * volume).max() < 1e-8 * volume,
+    f"{total}",
+)
+
+# 2. The exact array, along each axis.
+exact = lattice(0.0)
+kappas = []
+for axis in range(3):
+    g = np.zeros(3)
+    g[axis] = 1.0
+    kappas.append(-pfv_flow(exact, radii, cell_matrix(), tuple(g)).mean_velocity()[axis])
+print(f"simple cubic, exact: kappa PFV {kappas}")
+checks.check("exact array: isotropic", max(kappas) - min(kappas) < 1e-9 * kappas[0], f"{kappas}")
+checks.check(
+    "exact array: within 1 % of Zick & Homsy", abs(kappas[1] / ZICK_HOMSY - 1) < 0.01, f"{kappas[1]} vs {ZICK_HOMSY}"
+)
+
+# 3. Sheared by one spacing: the same lattice.
+sheared = cell_matrix()
+sheared[0, 1] = SIDE
+kappa_sheared = -pfv_flow(exact, radii, sheared).mean_velocity()[1]
+checks.check(
+    "exact array in a cell sheared by one period: the same kappa",
+    abs(kappa_sheared - kappas[1]) < 1e-8 * kappas[1],
+    f"{kappa_sheared} vs {kappas[1]}",
+)
+
+# 4. A dense random periodic packing of YADE's making, and eight copies of it.
+dense = pack.randomPeriPack(radius=0.5, initSize=(8, 8, 8), seed=1, noPrint=True)
+centres = np.array([tuple(s[0]) for s in dense])
+radii = np.array([s[1] for s in dense])
+h = np.diag(np.array(tuple(dense.cellSize)))
+volume = abs(np.linalg.det(h))
+flow = pfv_flow(centres, radii, h)
+total = flow.forces().sum(axis=0)
+checks.check(
+    f"randomPeriPack, {len(radii)} spheres: total force -gradP V",
+    np.abs(total + np.array(GRADIENT) * volume).max() < 1e-8 * volume,
+    f"{total}",
+)
+kappa_dense = -flow.mean_velocity()[1]
+shifts = [h @ np.array([i, j, k]) for i in range(2) for j in range(2) for k in range(2)]
+tiled = pfv_flow(np.concatenate([centres + t for t in shifts]), np.tile(radii, 8), 2 * h)
+kappa_tiled = -tiled.mean_velocity()[1]
+print(f"randomPeriPack: kappa {kappa_dense:.6g}, 2 x 2 x 2 copies {kappa_tiled:.6g}")
+checks.check("randomPeriPack: kappa positive", kappa_dense > 0, f"{kappa_dense}")
+checks.check(
+    "randomPeriPack: 2 x 2 x 2 copies give the same kappa",
+    abs(kappa_tiled - kappa_dense) < 1e-8 * kappa_dense,
+    f"{kappa_tiled} vs {kappa_dense}",
+)
+checks.report("periodic_vs_yade")

@@ -415,6 +415,11 @@ class FlowEngine(PyRunner):
         self._core.accept_step()
 
     def _step_parts(self, scene: Any, clock: Any) -> None:
+        if scene.periodic:
+            raise RuntimeError(
+                "pfv.FlowEngine needs a box bounded by walls, and the scene is periodic (O.periodic = True): use "
+                "pfv.PeriodicFlowEngine"
+            )
         scan, pos, walls = self._bodies.for_step(scene)
         clock.lap("scan and positions")
         dt = self._before_step(scene, scan)

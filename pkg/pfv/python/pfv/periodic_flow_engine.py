@@ -1,0 +1,304 @@
+"""pfv.PeriodicFlowEngine: the flow through a periodic cell (O.periodic = True) under an imposed mean pressure
+gradient, with the interface of YADE's PeriodicFlowEngine where it has a meaning (doc/periodic.md).
+
+A PyRunner, as pfv.FlowEngine: its command finds the engine by a key, and each step reads the spheres' centres, the
+cell's vectors (O.cell.hSize) and O.dt, runs the C++ step (pfv._core.PeriodicFlow) and adds the fluid forces to
+O.forces. The pressure is p = p~ + gradP . x with p~ periodic (doc/model.md); the cell may be a cuboid or sheared,
+and deform (its velocity gradient moves the images of the spheres, shear included).
+"""
+from __future__ import annotations
+
+import math
+import secrets
+import weakref
+from typing import Any
+
+import numpy as np
+import yade
+from yade.minieigenHP import Vector3
+from yade.wrapper import PyRunner, Sphere
+
+from ._core import PeriodicFlow, YadeForceBridge
+
+_COMMAND = "__import__('pfv.periodic_flow_engine').periodic_flow_engine._run({})"
+_engines = weakref.WeakValueDictionary()  # key -> engine: the PyRunner commands find their engine here
+
+# YADE's PyRunner attributes, which this engine keeps as a PyRunner does.
+_RUNNER_ATTRIBUTES = frozenset(
+    {
+        "command",
+        "iterPeriod",
+        "virtPeriod",
+        "realPeriod",
+        "nDo",
+        "initRun",
+        "firstIterRun",
+        "iterLast",
+        "virtLast",
+        "realLast",
+        "nDone",
+        "dead",
+        "label",
+        "ignoreErrors",
+        "updateGlobals",
+        "timingDeltas",
+        "execCount",
+        "execTime",
+    }
+)
+# Members of YADE's FlowEngine that describe the walls of a box: a periodic cell has none.
+_WALLED_ONLY = frozenset(
+    {
+        "wallIds",
+        "bndCondIsPressure",
+        "bndCondValue",
+        "boundaryUseMaxMin",
+        "wallThickness",
+        "slipBoundary",
+        "boundaryVelocity",
+        "boundaryPressure",
+        "boundaryXPos",
+        "xmin",
+        "xmax",
+        "ymin",
+        "ymax",
+        "zmin",
+        "zmax",
+        "getBoundaryFlux",
+        "setBoundaryNormal",
+        "imposeFluxes",
+        "clearImposedPressure",
+        "clearImposedFlux",
+        "bndCondIsTemperature",
+        "thermalBndCondValue",
+    }
+)
+_FIELDS = frozenset({"_core", "_key", "_settings", "_spheres", "_bridge", "_last_remesh", "_remesh_asked"})
+
+
+def _run(key: int) -> None:
+    engine = _engines.get(key)
+    if engine is None:
+        raise RuntimeError(
+            "pfv.PeriodicFlowEngine: this engine's state is not in this process (a scene saved with O.save and "
+            "loaded again): saving and loading a periodic engine is not supported yet; add a new engine after O.load"
+        )
+    engine._step()
+
+
+def _finite_vector(name: str, value: Any) -> tuple[float, float, float]:
+    try:
+        v = tuple(float(x) for x in value)
+    except TypeError:
+        raise TypeError(f"pfv.PeriodicFlowEngine.{name} must be a vector of three numbers, got {value!r}") from None
+    if len(v) != 3 or not all(math.isfinite(x) for x in v):
+        raise ValueError(f"pfv.PeriodicFlowEngine.{name} must be three finite numbers, got {value!r}")
+    return v
+
+
+def _number(name: str, value: Any, minimum: float, strict: bool) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"pfv.PeriodicFlowEngine.{name} must be a number, got {value!r}") from None
+    if not math.isfinite(x) or x < minimum or (strict and x == minimum):
+        bound = f"{'>' if strict else '>='} {minimum:g}"
+        raise ValueError(f"pfv.PeriodicFlowEngine.{name} must be finite and {bound}, got {value!r}")
+    return x
+
+
+class PeriodicFlowEngine(PyRunner):
+    """PFV's flow engine for periodic cells with the interface of YADE's PeriodicFlowEngine."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        PyRunner.__init__(self)
+        self._core = PeriodicFlow()
+        self._key = secrets.randbits(62)
+        self._settings = dict(
+            gradP=(0.0, 0.0, 0.0),
+            viscosity=1.0,
+            permeabilityFactor=1.0,
+            fluidBulkModulus=0.0,
+            meshUpdateInterval=1000,
+            defTolerance=0.05,
+            duplicateThreshold=0.06,
+            useSolver=3,
+        )
+        self._spheres = None  # (ids, radii, body count) of the last scan
+        self._bridge = None
+        self._last_remesh = None
+        self._remesh_asked = False
+        _engines[self._key] = self
+        self.command = _COMMAND.format(self._key)
+        self.iterPeriod = 1
+        self.initRun = True
+        for name, value in kwargs.items():
+            setattr(self, name, value)
+
+    # -- attributes ------------------------------------------------------------------------------
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in _FIELDS or isinstance(getattr(type(self), name, None), property):
+            object.__setattr__(self, name, value)
+        elif name in _RUNNER_ATTRIBUTES:
+            if name == "command" and getattr(self, "command", "") and value != self.command:
+                raise ValueError("command drives this pfv.PeriodicFlowEngine and cannot be changed")
+            object.__setattr__(self, name, value)
+        elif name in _WALLED_ONLY:
+            raise AttributeError(f"pfv.PeriodicFlowEngine has no walls: {name} has no meaning in a periodic cell")
+        else:
+            raise AttributeError(f"pfv.PeriodicFlowEngine has no attribute {name!r}")
+
+    def __getattr__(self, name: str) -> Any:  # only called when normal lookup fails
+        if name in _WALLED_ONLY:
+            raise AttributeError(f"pfv.PeriodicFlowEngine has no walls: {name} has no meaning in a periodic cell")
+        raise AttributeError(f"pfv.PeriodicFlowEngine has no attribute {name!r}")
+
+    def _apply_settings(self, **changes: Any) -> None:
+        s = dict(self._settings, **changes)
+        self._core.set_settings(s["viscosity"], s["permeabilityFactor"], s["gradP"], s["fluidBulkModulus"])
+        self._settings = s
+
+    @property
+    def gradP(self) -> Vector3:
+        """The imposed macroscopic pressure gradient (YADE's gradP): p = p~ + gradP . x."""
+        return Vector3(*self._settings["gradP"])
+
+    @gradP.setter
+    def gradP(self, value: Any) -> None:
+        self._apply_settings(gradP=_finite_vector("gradP", value))
+
+    @property
+    def viscosity(self) -> float:
+        return self._settings["viscosity"]
+
+    @viscosity.setter
+    def viscosity(self, value: Any) -> None:
+        self._apply_settings(viscosity=_number("viscosity", value, 0.0, strict=True))
+
+    @property
+    def permeabilityFactor(self) -> float:
+        return self._settings["permeabilityFactor"]
+
+    @permeabilityFactor.setter
+    def permeabilityFactor(self, value: Any) -> None:
+        self._apply_settings(permeabilityFactor=_number("permeabilityFactor", value, 0.0, strict=True))
+
+    @property
+    def fluidBulkModulus(self) -> float:
+        """The fluid's bulk modulus; 0 (YADE's default): incompressible."""
+        return self._settings["fluidBulkModulus"]
+
+    @fluidBulkModulus.setter
+    def fluidBulkModulus(self, value: Any) -> None:
+        self._apply_settings(fluidBulkModulus=_number("fluidBulkModulus", value, 0.0, strict=False))
+
+    @property
+    def meshUpdateInterval(self) -> int:
+        """Iterations between two remeshes."""
+        return self._settings["meshUpdateInterval"]
+
+    @meshUpdateInterval.setter
+    def meshUpdateInterval(self, value: Any) -> None:
+        self._settings["meshUpdateInterval"] = int(_number("meshUpdateInterval", value, 1.0, strict=False))
+
+    @property
+    def defTolerance(self) -> float:
+        """Accepted for YADE's scripts; the periodic engine remeshes every meshUpdateInterval iterations."""
+        return self._settings["defTolerance"]
+
+    @defTolerance.setter
+    def defTolerance(self, value: Any) -> None:
+        self._settings["defTolerance"] = _number("defTolerance", value, 0.0, strict=False)
+
+    @property
+    def duplicateThreshold(self) -> float:
+        """Accepted for YADE's scripts: YADE duplicates bodies near the cell's faces; PFV triangulates the
+        spheres' images (doc/periodic.md) and has nothing to duplicate."""
+        return self._settings["duplicateThreshold"]
+
+    @duplicateThreshold.setter
+    def duplicateThreshold(self, value: Any) -> None:
+        self._settings["duplicateThreshold"] = _number("duplicateThreshold", value, 0.0, strict=False)
+
+    @property
+    def useSolver(self) -> int:
+        """3 (the direct solve), the only solver of the periodic engine."""
+        return 3
+
+    @useSolver.setter
+    def useSolver(self, value: Any) -> None:
+        if value != 3:
+            raise ValueError(f"pfv.PeriodicFlowEngine.useSolver: only 3 (the direct solve) is available, got {value!r}")
+
+    @property
+    def updateTriangulation(self) -> bool:
+        return self._remesh_asked
+
+    @updateTriangulation.setter
+    def updateTriangulation(self, value: Any) -> None:
+        if value:
+            self._remesh_asked = True
+            self._core.request_remesh()
+
+    # -- queries ---------------------------------------------------------------------------------
+    def _require_mesh(self) -> None:
+        if not self._core.has_mesh():
+            raise RuntimeError("pfv.PeriodicFlowEngine has not run yet: no pore mesh (run at least one step)")
+
+    def getPorePressure(self, pos: Any) -> float:
+        """The pressure p~ + gradP . x at pos (any point: the periodic part is read in the cell)."""
+        self._require_mesh()
+        return self._core.pressure_at(_finite_vector("getPorePressure position", pos))
+
+    def averageVelocity(self) -> Vector3:
+        """The superficial (Darcy) velocity of the cell."""
+        self._require_mesh()
+        return Vector3(*self._core.mean_velocity())
+
+    def fluidForce(self, id: int) -> Vector3:
+        """The fluid force on sphere `id` at the last step."""
+        self._require_mesh()
+        ids = self._spheres[0]
+        rows = np.nonzero(ids == id)[0]
+        if len(rows) == 0:
+            raise IndexError(f"pfv.PeriodicFlowEngine.fluidForce: body {id} is not a sphere of the flow")
+        return Vector3(*self._core.forces()[rows[0]])
+
+    def nCells(self) -> int:
+        return self._core.n_cells
+
+    # -- the step --------------------------------------------------------------------------------
+    def _scan(self, scene: Any) -> tuple[np.ndarray, np.ndarray]:
+        if self._spheres is None or self._spheres[2] != len(scene.bodies):
+            ids, radii = [], []
+            for b in scene.bodies:
+                if b is not None and isinstance(b.shape, Sphere):
+                    ids.append(b.id)
+                    radii.append(b.shape.radius)
+            if not ids:
+                raise RuntimeError("pfv.PeriodicFlowEngine: the scene has no spheres")
+            ids = np.array(ids, dtype=np.int64)
+            self._spheres = (ids, np.array(radii), len(scene.bodies))
+            self._bridge = YadeForceBridge(Vector3, ids, np.arange(len(ids), dtype=np.int64))
+            self._core.request_remesh()
+        return self._spheres[0], self._spheres[1]
+
+    def _step(self) -> None:
+        scene = yade.O
+        if not scene.periodic:
+            raise RuntimeError(
+                "pfv.PeriodicFlowEngine needs a periodic cell (O.periodic = True); for a box bounded by walls use "
+                "pfv.FlowEngine"
+            )
+        ids, radii = self._scan(scene)
+        bodies = scene.bodies
+        centres = np.array([tuple(bodies[int(i)].state.pos) for i in ids])
+        h = np.array([[scene.cell.hSize[i, j] for j in range(3)] for i in range(3)])
+        if self._last_remesh is not None and scene.iter - self._last_remesh >= self.meshUpdateInterval:
+            self._core.request_remesh()
+        count = self._core.remesh_count
+        self._core.step(centres, radii, h, scene.dt)
+        if self._core.remesh_count != count or self._last_remesh is None:
+            self._last_remesh = scene.iter
+            self._remesh_asked = False
+        self._bridge.apply(scene.forces.addF, self._core.forces())

@@ -1,0 +1,115 @@
+"""pfv.PeriodicFlowEngine in a YADE scene: one line switches from YADE's engine, and bad input fails loudly.
+
+    yade-double -n -x tests/yade/flow/test_periodic_engine.py        (exit 0 = pass)
+
+A simple cubic array of 4 x 4 x 4 spheres (radius 0.4995, jittered by 1e-4) in a periodic cell, gradP along y,
+the engine written as YADE's: after two O.step() the forces YADE holds are the engine's, and both equal those of
+the C++ step (pfv._core.PeriodicFlow) on the same positions; averageVelocity is its Darcy velocity; the pressure
+at a point one period further along y is higher by gradP_y times the period. Then the errors: a periodic engine
+in a walled scene, pfv.FlowEngine in a periodic one, a non-finite gradP, a wall member, a cell thinner than two
+diameters, an unknown attribute; each names the problem and the scene runs on once it is put right.
+"""
+import numpy as np
+
+from pfv_testing import checks
+from yade import O, utils  # noqa: E402
+from yade.minieigenHP import Matrix3, Vector3  # noqa: E402
+from yade.wrapper import (  # noqa: E402
+    Bo1_Sphere_Aabb,
+    ForceResetter,
+    Ig2_Sphere_Sphere_ScGeom,
+    InsertionSortCollider,
+    InteractionLoop,
+    Ip2_FrictMat_FrictMat_FrictPhys,
+    Law2_ScGeom_FrictPhys_CundallStrack,
+    NewtonIntegrator,
+)
+import pfv._core as core  # noqa: E402
+from pfv import FlowEngine, PeriodicFlowEngine  # noqa: E402
+
+SIDE, RADIUS = 4, 0.4995
+GRADIENT = (0.0, 2.0, 0.0)
+
+
+def scene(periodic=True, side=SIDE):
+    O.reset()
+    O.periodic = periodic
+    if periodic:
+        O.cell.hSize = Matrix3(side, 0, 0, 0, side, 0, 0, 0, side)
+    rng = np.random.default_rng(7)
+    for i in range(side):
+        for j in range(side):
+            for k in range(side):
+                c = np.array([i + 0.5, j + 0.5, k + 0.5]) + rng.uniform(-1e-4, 1e-4, 3)
+                O.bodies.append(utils.sphere(tuple(c), RADIUS, fixed=True))
+    O.dt = 1e-5
+
+
+def engines(flow):
+    O.engines = [
+        ForceResetter(),
+        InsertionSortCollider([Bo1_Sphere_Aabb()], allowBiggerThanPeriod=True),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()], [Law2_ScGeom_FrictPhys_CundallStrack()]
+        ),
+        flow,
+        NewtonIntegrator(),
+    ]
+
+
+# The drop-in: YADE's script with the engine's import changed.
+scene()
+flow = PeriodicFlowEngine(gradP=Vector3(*GRADIENT), viscosity=1.0, useSolver=3, label="flow")
+engines(flow)
+O.step()
+O.step()
+n = len(O.bodies)
+centres = np.array([tuple(O.bodies[i].state.pos) for i in range(n)])
+h = np.array([[O.cell.hSize[i, j] for j in range(3)] for i in range(3)])
+direct = core.PeriodicFlow()
+direct.set_settings(viscosity=1.0, permeability_factor=1.0, gradient=GRADIENT, bulk_modulus=0.0)
+direct.step(centres, np.full(n, RADIUS), h, O.dt)
+held = np.array([tuple(O.forces.f(i)) for i in range(n)])
+reported = np.array([tuple(flow.fluidForce(i)) for i in range(n)])
+scale = np.abs(direct.forces()).max()
+checks.check("O.forces holds the engine's forces", np.abs(held - reported).max() <= 1e-12 * scale)
+checks.check("the engine's forces are the C++ step's", np.abs(reported - direct.forces()).max() <= 1e-12 * scale)
+velocity = np.array(tuple(flow.averageVelocity()))
+checks.check(
+    "averageVelocity is the Darcy velocity of the C++ step",
+    np.abs(velocity - direct.mean_velocity()).max() <= 1e-12 * np.abs(velocity).max(),
+    f"{velocity}",
+)
+checks.check("the flow goes down the gradient", velocity[1] < 0, f"{velocity}")
+x = (1.3, 0.7, 2.1)
+rise = flow.getPorePressure((x[0], x[1] + SIDE, x[2])) - flow.getPorePressure(x)
+checks.check("one period further along y the pressure is gradP_y L higher", abs(rise - 2.0 * SIDE) < 1e-9, f"{rise}")
+checks.check("no remesh between the two steps", direct.remesh_count == 1 and flow.nCells() == direct.n_cells)
+
+# Errors.
+checks.expect_error("gradP = (nan, 0, 0)", ValueError, "gradP", lambda: setattr(flow, "gradP", (float("nan"), 0, 0)))
+checks.expect_error("viscosity = 0", ValueError, "viscosity", lambda: setattr(flow, "viscosity", 0))
+checks.expect_error("wallIds", AttributeError, "wallIds", lambda: setattr(flow, "wallIds", [0, 1, 2, 3, 4, 5]))
+checks.expect_error("bndCondIsPressure read", AttributeError, "bndCondIsPressure", lambda: flow.bndCondIsPressure)
+checks.expect_error("an unknown attribute", AttributeError, "gradp", lambda: setattr(flow, "gradp", (0, 1, 0)))
+checks.expect_error("useSolver = 0", ValueError, "useSolver", lambda: setattr(flow, "useSolver", 0))
+checks.check("the rejected settings left gradP as it was", tuple(flow.gradP) == GRADIENT, f"{flow.gradP}")
+O.step()
+checks.check(
+    "the engine steps on after the refusals",
+    np.abs(np.array(tuple(flow.averageVelocity())) - velocity).max() <= 1e-12 * np.abs(velocity).max(),
+)
+
+scene(periodic=False)
+engines(PeriodicFlowEngine(gradP=Vector3(*GRADIENT)))
+checks.expect_error("PeriodicFlowEngine in a walled scene", Exception, "O.periodic", O.step)
+
+scene()
+walled = FlowEngine()
+engines(walled)
+checks.expect_error("pfv.FlowEngine in a periodic scene", Exception, "PeriodicFlowEngine", O.step)
+
+scene(side=1)
+engines(PeriodicFlowEngine(gradP=Vector3(*GRADIENT)))
+checks.expect_error("a cell one sphere thick", Exception, "diameters", O.step)
+checks.report("periodic_engine")

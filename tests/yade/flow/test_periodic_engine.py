@@ -85,6 +85,7 @@ x = (1.3, 0.7, 2.1)
 rise = flow.getPorePressure((x[0], x[1] + SIDE, x[2])) - flow.getPorePressure(x)
 checks.check("one period further along y the pressure is gradP_y L higher", abs(rise - 2.0 * SIDE) < 1e-9, f"{rise}")
 checks.check("no remesh between the two steps", direct.remesh_count == 1 and flow.nCells() == direct.n_cells)
+checks.check("the centres come from YADE's SpherePack (checked against its Python interface)", flow._pack is not None)
 
 # Errors.
 checks.expect_error("gradP = (nan, 0, 0)", ValueError, "gradP", lambda: setattr(flow, "gradP", (float("nan"), 0, 0)))
@@ -99,6 +100,21 @@ checks.check(
     "the engine steps on after the refusals",
     np.abs(np.array(tuple(flow.averageVelocity())) - velocity).max() <= 1e-12 * np.abs(velocity).max(),
 )
+
+# An erased sphere (len(O.bodies) unchanged): the engine rescans and remeshes without it.
+cells = flow.nCells()
+O.bodies.erase(5)
+O.step()
+rest = [i for i in range(n) if i != 5]
+again = core.PeriodicFlow()
+again.set_settings(viscosity=1.0, permeability_factor=1.0, gradient=GRADIENT, bulk_modulus=0.0)
+again.step(centres[rest], np.full(n - 1, RADIUS), h, O.dt)
+checks.check("after erasing a sphere: its pores are gone", flow.nCells() == again.n_cells and flow.nCells() != cells)
+checks.check(
+    "after erasing a sphere: the forces of a fresh step without it",
+    np.abs(np.array([tuple(flow.fluidForce(i)) for i in rest]) - again.forces()).max() <= 1e-12 * scale,
+)
+checks.expect_error("fluidForce of the erased sphere", IndexError, "5", lambda: flow.fluidForce(5))
 
 scene(periodic=False)
 engines(PeriodicFlowEngine(gradP=Vector3(*GRADIENT)))

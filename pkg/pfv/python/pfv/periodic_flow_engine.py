@@ -16,9 +16,10 @@ from typing import Any
 import numpy as np
 import yade
 from yade.minieigenHP import Vector3
+from yade._packSpheres import SpherePack
 from yade.wrapper import PyRunner, Sphere
 
-from ._core import PeriodicFlow, YadeForceBridge
+from ._core import PeriodicFlow, YadeForceBridge, gather_sphere_pack, sphere_pack_size
 
 _COMMAND = "__import__('pfv.periodic_flow_engine').periodic_flow_engine._run({})"
 _engines = weakref.WeakValueDictionary()  # key -> engine: the PyRunner commands find their engine here
@@ -73,7 +74,7 @@ _WALLED_ONLY = frozenset(
         "thermalBndCondValue",
     }
 )
-_FIELDS = frozenset({"_core", "_key", "_settings", "_spheres", "_bridge", "_last_remesh", "_remesh_asked"})
+_FIELDS = frozenset({"_core", "_key", "_settings", "_spheres", "_bridge", "_pack", "_last_remesh", "_remesh_asked"})
 
 
 def _run(key: int) -> None:
@@ -126,6 +127,7 @@ class PeriodicFlowEngine(PyRunner):
         )
         self._spheres = None  # (ids, radii, body count) of the last scan
         self._bridge = None
+        self._pack = None  # a SpherePack whose array holds the centres (YADE's fromSimulation), or None
         self._last_remesh = None
         self._remesh_asked = False
         _engines[self._key] = self
@@ -268,20 +270,49 @@ class PeriodicFlowEngine(PyRunner):
         return self._core.n_cells
 
     # -- the step --------------------------------------------------------------------------------
-    def _scan(self, scene: Any) -> tuple[np.ndarray, np.ndarray]:
-        if self._spheres is None or self._spheres[2] != len(scene.bodies):
-            ids, radii = [], []
-            for b in scene.bodies:
-                if b is not None and isinstance(b.shape, Sphere):
-                    ids.append(b.id)
-                    radii.append(b.shape.radius)
-            if not ids:
-                raise RuntimeError("pfv.PeriodicFlowEngine: the scene has no spheres")
-            ids = np.array(ids, dtype=np.int64)
-            self._spheres = (ids, np.array(radii), len(scene.bodies))
-            self._bridge = YadeForceBridge(Vector3, ids, np.arange(len(ids), dtype=np.int64))
-            self._core.request_remesh()
-        return self._spheres[0], self._spheres[1]
+    def _scan(self, scene: Any) -> None:
+        """The spheres (ids, radii), the force bridge, and how the centres are read: from a SpherePack filled by
+        YADE's C++ fromSimulation (unwrapped centres, sphere bodies in id order) when it gives what YADE's Python
+        interface gives for every sphere, else body by body."""
+        ids, radii, centres = [], [], []
+        for b in scene.bodies:
+            if b is not None and isinstance(b.shape, Sphere):
+                ids.append(b.id)
+                radii.append(b.shape.radius)
+                centres.append(tuple(b.state.pos))
+        if not ids:
+            raise RuntimeError("pfv.PeriodicFlowEngine: the scene has no spheres")
+        n = len(ids)
+        ids = np.array(ids, dtype=np.int64)
+        self._spheres = (ids, np.array(radii), len(scene.bodies))
+        self._bridge = YadeForceBridge(Vector3, ids, np.arange(n, dtype=np.int64))
+        pack = SpherePack()
+        pack.fromSimulation()
+        read, read_radii = np.empty((n, 3)), np.empty(n)
+        index = np.arange(n, dtype=np.int64)
+        same = (
+            sphere_pack_size(pack) == n
+            and gather_sphere_pack(pack, index, read, read_radii, n)
+            and np.array_equal(read, np.array(centres))
+            and np.array_equal(read_radii, self._spheres[1])
+        )
+        self._pack = (pack, index) if same else None
+
+    def _centres(self, scene: Any) -> np.ndarray | None:
+        """The spheres' centres now, or None if bodies were added or erased since the scan."""
+        ids = self._spheres[0]
+        if self._pack is not None:
+            pack, index = self._pack
+            pack.fromSimulation()
+            centres = np.empty((len(ids), 3))
+            return centres if gather_sphere_pack(pack, index, centres, None, len(ids)) else None
+        bodies = scene.bodies
+        if len(bodies) != self._spheres[2]:
+            return None
+        try:
+            return np.array([tuple(bodies[int(i)].state.pos) for i in ids])
+        except (AttributeError, IndexError):  # an erased body
+            return None
 
     def _step(self) -> None:
         scene = yade.O
@@ -290,14 +321,18 @@ class PeriodicFlowEngine(PyRunner):
                 "pfv.PeriodicFlowEngine needs a periodic cell (O.periodic = True); for a box bounded by walls use "
                 "pfv.FlowEngine"
             )
-        ids, radii = self._scan(scene)
-        bodies = scene.bodies
-        centres = np.array([tuple(bodies[int(i)].state.pos) for i in ids])
-        h = np.array([[scene.cell.hSize[i, j] for j in range(3)] for i in range(3)])
-        if self._last_remesh is not None and scene.iter - self._last_remesh >= self.meshUpdateInterval:
+        scheduled = self._last_remesh is not None and scene.iter - self._last_remesh >= self.meshUpdateInterval
+        if self._spheres is None or self._spheres[2] != len(scene.bodies) or self._remesh_asked or scheduled:
+            self._scan(scene)  # the radii are read at each remesh
             self._core.request_remesh()
+        centres = self._centres(scene)
+        if centres is None:  # bodies erased (which keeps len(O.bodies)) or added
+            self._scan(scene)
+            self._core.request_remesh()
+            centres = self._centres(scene)
+        h = np.array([[scene.cell.hSize[i, j] for j in range(3)] for i in range(3)])
         count = self._core.remesh_count
-        self._core.step(centres, radii, h, scene.dt)
+        self._core.step(centres, self._spheres[1], h, scene.dt)
         if self._core.remesh_count != count or self._last_remesh is None:
             self._last_remesh = scene.iter
             self._remesh_asked = False

@@ -51,6 +51,9 @@ class PeriodicFlow {
 
   // Asks for a new mesh at the next step.
   void request_remesh() { remesh_due_ = true; }
+  // The next step has no dV/dt term: the positions of the last step are not where this one's
+  // motion started (a gap in the iterations, a scene loaded or replaced).
+  void forget_motion() { has_previous_ = false; }
   bool has_mesh() const { return mesh_ != nullptr; }
 
   // One step of length dt with the spheres at centres (anywhere, unwrapped) and the cell's

@@ -49,6 +49,7 @@ void bind_periodic(py::module_& m) {
           py::arg("centres"), py::arg("radii"), py::arg("h"), py::arg("dt"),
           "One step: centres (n, 3), radii (n,), the cell's vectors h (3, 3, columns as YADE's hSize), dt.")
       .def("request_remesh", &PeriodicFlow::request_remesh)
+      .def("forget_motion", &PeriodicFlow::forget_motion)
       .def("has_mesh", &PeriodicFlow::has_mesh)
       .def_property_readonly("remesh_count", &PeriodicFlow::remesh_count)
       .def_property_readonly("n_cells", [](const PeriodicFlow& f) { return f.has_mesh() ? f.mesh().n_cells() : 0; })

@@ -74,7 +74,9 @@ _WALLED_ONLY = frozenset(
         "thermalBndCondValue",
     }
 )
-_FIELDS = frozenset({"_core", "_key", "_settings", "_spheres", "_bridge", "_pack", "_last_remesh", "_remesh_asked"})
+_FIELDS = frozenset(
+    {"_core", "_key", "_settings", "_spheres", "_bridge", "_pack", "_last_remesh", "_remesh_asked", "_last_step"}
+)
 
 
 def _run(key: int) -> None:
@@ -130,6 +132,7 @@ class PeriodicFlowEngine(PyRunner):
         self._pack = None  # a SpherePack whose array holds the centres (YADE's fromSimulation), or None
         self._last_remesh = None
         self._remesh_asked = False
+        self._last_step = None  # O.iter of the last step
         _engines[self._key] = self
         self.command = _COMMAND.format(self._key)
         self.iterPeriod = 1
@@ -321,6 +324,10 @@ class PeriodicFlowEngine(PyRunner):
                 "pfv.PeriodicFlowEngine needs a periodic cell (O.periodic = True); for a box bounded by walls use "
                 "pfv.FlowEngine"
             )
+        # dV/dt compares this step's positions with the last step's: not across a gap in the iterations (the engine
+        # dead for a while, O.reset, O.loadTmp of an earlier state), where the motion since then is unknown.
+        if self._last_step is not None and self._last_step != scene.iter - 1:
+            self._core.forget_motion()
         scheduled = self._last_remesh is not None and scene.iter - self._last_remesh >= self.meshUpdateInterval
         if self._spheres is None or self._spheres[2] != len(scene.bodies) or self._remesh_asked or scheduled:
             self._scan(scene)  # the radii are read at each remesh
@@ -337,3 +344,4 @@ class PeriodicFlowEngine(PyRunner):
             self._last_remesh = scene.iter
             self._remesh_asked = False
         self._bridge.apply(scene.forces.addF, self._core.forces())
+        self._last_step = scene.iter

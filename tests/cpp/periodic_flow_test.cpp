@@ -100,6 +100,14 @@ TEST(PeriodicFlow, DrainedSteadyFlowMatchesTheModelsIdentities) {
   EXPECT_NEAR(flow.pressure_at(x), px, 1e-12 * std::abs(px) + 1e-12);
   const Vec3 t = p.cell.translation({1, -2, 0});
   EXPECT_NEAR(flow.pressure_at(x + t), px + gradient.dot(t), 1e-9 * (std::abs(px) + 1));
+  // A new gradient takes effect at the next step, on the same mesh and factor.
+  const Vec3 other(1.5, 0, 0);
+  flow.set_settings(settings(0, other));
+  flow.step(p.centre, p.radius, p.cell.h, 1e-4);
+  EXPECT_EQ(flow.remesh_count(), 1);
+  Vec3 pushed = Vec3::Zero();
+  for (const Vec3& f : flow.forces()) pushed += f;
+  EXPECT_LT((pushed + other * p.cell.volume()).norm(), 1e-8 * other.norm() * p.cell.volume());
 }
 
 TEST(PeriodicFlow, ARemeshCarriesThePressuresAndKeepsDVdt) {

@@ -35,7 +35,8 @@ struct PeriodicFlow::Mesh {
   CellGeometry cells;
   FacetGeometry facets;
   std::vector<double> conductance;
-  std::vector<double> orientation;  // per cell, the sign of its volume when meshed
+  std::vector<double> gradient_source;  // s of the imposed gradient: per system and gradient, not per step
+  std::vector<double> orientation;      // per cell, the sign of its volume when meshed
   PeriodicPressureSystem system;
   ForceCache cache;
   PeriodicForces forces;
@@ -52,6 +53,7 @@ void PeriodicFlow::set_settings(const PeriodicFlowSettings& s) {
   if (s.viscosity != settings_.viscosity || s.permeability_factor != settings_.permeability_factor ||
       s.bulk_modulus != settings_.bulk_modulus)
     system_due_ = true;
+  if (s.gradient != settings_.gradient) source_due_ = true;
   settings_ = s;
 }
 
@@ -100,6 +102,10 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
     remesh(centres, radii, h);
   }
   if (system_due_ || (settings_.bulk_modulus > 0 && dt != system_dt_)) build_system(dt);
+  if (source_due_) {
+    mesh_->gradient_source = gradient_source(mesh_->cells, mesh_->facets, mesh_->conductance, settings_.gradient);
+    source_due_ = false;
+  }
 
   const PeriodicMesh& m = mesh_->periodic();
   const int nc = m.n_cells();
@@ -110,7 +116,7 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
     volume[c] = mesh_->orientation[c] * tetrahedron_volume(m.mesh.cell_vertices[c], images_);
     if (has_previous_) volume_rate_[c] = (volume[c] - volume_[c]) / dt;
   }
-  std::vector<double> per_cell = gradient_source(mesh_->cells, mesh_->facets, mesh_->conductance, settings_.gradient);
+  std::vector<double> per_cell = mesh_->gradient_source;
   for (int c = 0; c < nc; ++c) {
     per_cell[c] -= volume_rate_[c];
     if (!storage_.empty()) per_cell[c] += storage_[c] * periodic_pressure_[c];
@@ -192,6 +198,7 @@ void PeriodicFlow::build_system(double dt) {
   }
   system_dt_ = dt;
   system_due_ = false;
+  source_due_ = true;  // new conductances
 }
 
 std::vector<double> PeriodicFlow::pressure() const {

@@ -83,7 +83,7 @@ class PeriodicFlow {
 
   PeriodicFlowSettings settings_;
   std::unique_ptr<Mesh> mesh_;
-  bool remesh_due_ = true, system_due_ = true, has_previous_ = false;
+  bool remesh_due_ = true, system_due_ = true, source_due_ = true, has_previous_ = false;
   double system_dt_ = 0;
   int remeshes_ = 0;
   Eigen::Matrix3d h_ = Eigen::Matrix3d::Identity();

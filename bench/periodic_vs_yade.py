@@ -16,44 +16,18 @@ permeability (-averageVelocity_y). No time is asserted anywhere.
 import statistics
 import sys
 
-import numpy as np
-
+from pfv_testing import periodic_scene
 from pfv_testing.cli import option
 from pfv_testing.timing import yade_step
 
-RADIUS, JITTER = 0.4995, 1e-4
+JITTER = 1e-4
 
 
 def build(side):
-    from yade import O, utils
-    from yade.minieigenHP import Matrix3
-    from yade.wrapper import (
-        Bo1_Sphere_Aabb,
-        ForceResetter,
-        Ig2_Sphere_Sphere_ScGeom,
-        InsertionSortCollider,
-        InteractionLoop,
-        Ip2_FrictMat_FrictMat_FrictPhys,
-        Law2_ScGeom_FrictPhys_CundallStrack,
-        NewtonIntegrator,
-    )
+    from yade import O
 
-    O.reset()
-    O.periodic = True
-    O.cell.hSize = Matrix3(side, 0, 0, 0, side, 0, 0, 0, side)
-    rng = np.random.default_rng(5)
-    grid = np.array([[i + 0.5, j + 0.5, k + 0.5] for i in range(side) for j in range(side) for k in range(side)])
-    for c in grid + rng.uniform(-JITTER, JITTER, grid.shape):
-        O.bodies.append(utils.sphere(tuple(c), RADIUS, fixed=True))
-    O.dt = 1e-5
-    O.engines = [
-        ForceResetter(),
-        InsertionSortCollider([Bo1_Sphere_Aabb()], allowBiggerThanPeriod=True),
-        InteractionLoop(
-            [Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()], [Law2_ScGeom_FrictPhys_CundallStrack()]
-        ),
-        NewtonIntegrator(),
-    ]
+    periodic_scene.build(side, JITTER)
+    O.engines = periodic_scene.dem_engines()
     O.step()
     O.step()
 

@@ -12,49 +12,22 @@ diameters, an unknown attribute; each names the problem and the scene runs on on
 import numpy as np
 
 from pfv_testing import checks
-from yade import O, utils  # noqa: E402
-from yade.minieigenHP import Matrix3, Vector3  # noqa: E402
-from yade.wrapper import (  # noqa: E402
-    Bo1_Sphere_Aabb,
-    ForceResetter,
-    Ig2_Sphere_Sphere_ScGeom,
-    InsertionSortCollider,
-    InteractionLoop,
-    Ip2_FrictMat_FrictMat_FrictPhys,
-    Law2_ScGeom_FrictPhys_CundallStrack,
-    NewtonIntegrator,
-)
+from pfv_testing.periodic_scene import RADIUS, build, cell_matrix, dem_engines
+from yade import O  # noqa: E402
+from yade.minieigenHP import Vector3  # noqa: E402
 import pfv._core as core  # noqa: E402
 from pfv import FlowEngine, PeriodicFlowEngine  # noqa: E402
 
-SIDE, RADIUS = 4, 0.4995
+SIDE = 4
 GRADIENT = (0.0, 2.0, 0.0)
 
 
 def scene(periodic=True, side=SIDE):
-    O.reset()
-    O.periodic = periodic
-    if periodic:
-        O.cell.hSize = Matrix3(side, 0, 0, 0, side, 0, 0, 0, side)
-    rng = np.random.default_rng(7)
-    for i in range(side):
-        for j in range(side):
-            for k in range(side):
-                c = np.array([i + 0.5, j + 0.5, k + 0.5]) + rng.uniform(-1e-4, 1e-4, 3)
-                O.bodies.append(utils.sphere(tuple(c), RADIUS, fixed=True))
-    O.dt = 1e-5
+    build(side, jitter=1e-4, seed=7, periodic=periodic)
 
 
 def engines(flow):
-    O.engines = [
-        ForceResetter(),
-        InsertionSortCollider([Bo1_Sphere_Aabb()], allowBiggerThanPeriod=True),
-        InteractionLoop(
-            [Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()], [Law2_ScGeom_FrictPhys_CundallStrack()]
-        ),
-        flow,
-        NewtonIntegrator(),
-    ]
+    O.engines = dem_engines(flow)
 
 
 # The drop-in: YADE's script with the engine's import changed.
@@ -65,7 +38,7 @@ O.step()
 O.step()
 n = len(O.bodies)
 centres = np.array([tuple(O.bodies[i].state.pos) for i in range(n)])
-h = np.array([[O.cell.hSize[i, j] for j in range(3)] for i in range(3)])
+h = cell_matrix()
 direct = core.PeriodicFlow()
 direct.set_settings(viscosity=1.0, permeability_factor=1.0, gradient=GRADIENT, bulk_modulus=0.0)
 direct.step(centres, np.full(n, RADIUS), h, O.dt)
@@ -110,7 +83,7 @@ O.step()
 before = flow._core.periodic_pressure()
 fluid = flow._core.fluid_volumes()
 strain = 1e-5
-old_h = np.array([[O.cell.hSize[i, j] for j in range(3)] for i in range(3)])
+old_h = cell_matrix()
 O.cell.hSize = O.cell.hSize * (1 - strain)
 for i in range(n):
     if O.bodies[i] is not None:
@@ -141,7 +114,7 @@ checks.check(
 flow.fluidBulkModulus = 0
 flow.gradP = GRADIENT
 centres = np.array([tuple(O.bodies[i].state.pos) for i in range(n)])
-h = np.array([[O.cell.hSize[i, j] for j in range(3)] for i in range(3)])
+h = cell_matrix()
 O.step()
 cells = flow.nCells()
 O.bodies.erase(5)

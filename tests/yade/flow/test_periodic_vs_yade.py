@@ -20,28 +20,15 @@
 import numpy as np
 
 from pfv_testing import checks
-from yade import O, utils, pack  # noqa: E402
-from yade.minieigenHP import Matrix3, Vector3  # noqa: E402
-from yade.wrapper import (  # noqa: E402
-    Bo1_Sphere_Aabb,
-    ForceResetter,
-    Ig2_Sphere_Sphere_ScGeom,
-    InsertionSortCollider,
-    InteractionLoop,
-    Ip2_FrictMat_FrictMat_FrictPhys,
-    Law2_ScGeom_FrictPhys_CundallStrack,
-    NewtonIntegrator,
-    PeriodicFlowEngine,
-)
+from pfv_testing.periodic_scene import RADIUS, build, cell_matrix, cubic_array, dem_engines
+from yade import O, pack  # noqa: E402
+from yade.minieigenHP import Vector3  # noqa: E402
+from yade.wrapper import PeriodicFlowEngine  # noqa: E402
 import pfv._core as core  # noqa: E402
 
-SIDE, RADIUS, JITTER = 6, 0.4995, 1e-4
+SIDE, JITTER = 6, 1e-4
 GRADIENT = (0.0, 1.0, 0.0)
 ZICK_HOMSY = 2.0 * 0.5**2 / (9 * 0.5236 * 42.14)
-
-
-def cell_matrix():
-    return np.array([[O.cell.hSize[i, j] for j in range(3)] for i in range(3)])
 
 
 def pfv_flow(centres, radii, h, gradient=GRADIENT):
@@ -51,29 +38,10 @@ def pfv_flow(centres, radii, h, gradient=GRADIENT):
     return flow
 
 
-def lattice(jitter, seed=5):
-    rng = np.random.default_rng(seed)
-    grid = np.array([[i + 0.5, j + 0.5, k + 0.5] for i in range(SIDE) for j in range(SIDE) for k in range(SIDE)])
-    return grid + (rng.uniform(-jitter, jitter, grid.shape) if jitter else 0.0)
-
-
 # 1. Side by side on the jittered array.
-O.periodic = True
-O.cell.hSize = Matrix3(SIDE, 0, 0, 0, SIDE, 0, 0, 0, SIDE)
-centres = lattice(JITTER)
-for c in centres:
-    O.bodies.append(utils.sphere(tuple(c), RADIUS, fixed=True))
+centres = build(SIDE, JITTER)
 yade_flow = PeriodicFlowEngine(gradP=Vector3(*GRADIENT), viscosity=1.0, useSolver=3)
-O.engines = [
-    ForceResetter(),
-    InsertionSortCollider([Bo1_Sphere_Aabb()], allowBiggerThanPeriod=True),
-    InteractionLoop(
-        [Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()], [Law2_ScGeom_FrictPhys_CundallStrack()]
-    ),
-    yade_flow,
-    NewtonIntegrator(),
-]
-O.dt = 1e-5
+O.engines = dem_engines(yade_flow)
 O.step()
 O.step()
 yade_kappa = -yade_flow.averageVelocity()[1]
@@ -98,7 +66,7 @@ checks.check(
 )
 
 # 2. The exact array, along each axis.
-exact = lattice(0.0)
+exact = cubic_array(SIDE)
 kappas = []
 for axis in range(3):
     g = np.zeros(3)

@@ -1,11 +1,6 @@
 #include "triangulation/periodic_triangulation.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Regular_triangulation_3.h>
-#include <CGAL/Regular_triangulation_cell_base_3.h>
-#include <CGAL/Regular_triangulation_vertex_base_3.h>
-#include <CGAL/Triangulation_cell_base_with_info_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include "triangulation/cgal_regular.hpp"
 
 #include <Eigen/LU>
 #include <algorithm>
@@ -16,16 +11,10 @@
 #include <utility>
 
 namespace pfv {
-namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, CGAL::Regular_triangulation_vertex_base_3<K>>;
-using Cb = CGAL::Triangulation_cell_base_with_info_3<
-    int, K,
-    CGAL::Regular_triangulation_cell_base_3<K, CGAL::Triangulation_cell_base_3<K>, CGAL::Discard_hidden_points>>;
-using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
-using RT = CGAL::Regular_triangulation_3<K, Tds>;
-using WPoint = RT::Weighted_point;
+using namespace cgal_regular;
+
+namespace {
 
 // A sphere translated by whole periods: the vertices of the infinite periodic triangulation.
 struct Image {

@@ -1,12 +1,8 @@
 #include "triangulation/regular_triangulation.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Regular_triangulation_3.h>
-#include <CGAL/Regular_triangulation_cell_base_3.h>
-#include <CGAL/Regular_triangulation_vertex_base_3.h>
+#include "triangulation/cgal_regular.hpp"
+
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
-#include <CGAL/Triangulation_cell_base_with_info_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <CGAL/property_map.h>
 #include <CGAL/spatial_sort.h>
 
@@ -15,19 +11,8 @@
 #include <utility>
 
 namespace pfv {
-namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, CGAL::Regular_triangulation_vertex_base_3<K>>;
-// Hidden points are not needed (they are reported from vertex info), so do not store them.
-using Cb = CGAL::Triangulation_cell_base_with_info_3<
-    int, K,
-    CGAL::Regular_triangulation_cell_base_3<K, CGAL::Triangulation_cell_base_3<K>, CGAL::Discard_hidden_points>>;
-using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
-using RT = CGAL::Regular_triangulation_3<K, Tds>;
-using WPoint = RT::Weighted_point;
-
-}  // namespace
+using namespace cgal_regular;
 
 struct RegularTriangulation::Impl {
   RT rt;

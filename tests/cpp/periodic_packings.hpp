@@ -54,4 +54,18 @@ inline PeriodicPacking random_periodic(int n, unsigned seed, const Eigen::Matrix
   return p;
 }
 
+// The same infinite packing in a cell twice as large along each vector: 2 x 2 x 2 copies.
+inline PeriodicPacking tiled(const PeriodicPacking& p) {
+  PeriodicPacking big;
+  big.cell.h = 2 * p.cell.h;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k)
+        for (std::size_t s = 0; s < p.centre.size(); ++s) {
+          big.centre.push_back(p.centre[s] + p.cell.translation({i, j, k}));
+          big.radius.push_back(p.radius[s]);
+        }
+  return big;
+}
+
 }  // namespace pfv::test

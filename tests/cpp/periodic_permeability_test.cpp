@@ -162,15 +162,7 @@ TEST(PeriodicPermeability, CopiesTranslationsAndTheCellsChoiceChangeNothing) {
   const Vec3 e(0.2, 1.0, -0.4);
   const double kappa = permeability(p, e);
   ASSERT_GT(kappa, 0);
-  PeriodicPacking big;
-  big.cell.h = 2 * p.cell.h;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
-      for (int k = 0; k < 2; ++k)
-        for (std::size_t s = 0; s < p.centre.size(); ++s) {
-          big.centre.push_back(p.centre[s] + p.cell.translation({i, j, k}));
-          big.radius.push_back(p.radius[s]);
-        }
+  const PeriodicPacking big = pfv::test::tiled(p);
   EXPECT_NEAR(permeability(big, e), kappa, 1e-8 * kappa);
   PeriodicPacking moved = p;
   for (Vec3& x : moved.centre) x += Vec3(0.43, 0.11, -0.72);

@@ -192,15 +192,7 @@ TEST(PeriodicTriangulation, TwoByTwoByTwoCopiesHaveEightTimesTheCells) {
   const auto p = random_periodic(60, 8, diagonal(1, 1.1, 0.9), 0.05, 0.1);
   PeriodicTriangulation tri;
   const auto one = sorted_volumes(tri.build(p.centre, p.radius, p.cell));
-  PeriodicPacking big;
-  big.cell.h = 2 * p.cell.h;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
-      for (int k = 0; k < 2; ++k)
-        for (std::size_t s = 0; s < p.centre.size(); ++s) {
-          big.centre.push_back(p.centre[s] + p.cell.translation({i, j, k}));
-          big.radius.push_back(p.radius[s]);
-        }
+  const PeriodicPacking big = pfv::test::tiled(p);
   const auto eight = sorted_volumes(tri.build(big.centre, big.radius, big.cell));
   std::vector<double> expected;
   for (double v : one) expected.insert(expected.end(), 8, v);

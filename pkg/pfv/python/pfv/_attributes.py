@@ -261,3 +261,11 @@ def as_numbers(name: str, value: Any) -> list[float]:
     if isinstance(value, (str, bytes)) or not isinstance(value, Sequence | np.ndarray):
         raise TypeError(f"{name} must be a sequence of numbers, got {value!r}")
     return [as_number(f"{name}[{i}]", v) for i, v in enumerate(value)]
+
+
+def runner_attributes(runner: type, engine: type) -> frozenset[str]:
+    """The data attributes of YADE's PyRunner (`runner`) that an engine subclass (`engine`) keeps as a PyRunner does:
+    those it does not define itself."""
+    return frozenset(
+        a for a in dir(runner) if not a.startswith("_") and not callable(getattr(runner, a)) and a not in vars(engine)
+    )

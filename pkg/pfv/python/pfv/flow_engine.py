@@ -586,10 +586,6 @@ _OWN_ATTRIBUTES = frozenset(a for a in dir(PyRunner) if not a.startswith("__")) 
 }
 # YADE's PyRunner attributes, checked by YADE's converters: all but FlowEngine's own properties
 # (ompThreads, timingDeltas).
-_RUNNER_ATTRIBUTES = frozenset(
-    a
-    for a in dir(PyRunner)
-    if not a.startswith("_") and not callable(getattr(PyRunner, a)) and a not in vars(FlowEngine)
-)
+_RUNNER_ATTRIBUTES = attributes.runner_attributes(PyRunner, FlowEngine)
 
 _persistence.install()  # O.save / O.load carry the engines' state

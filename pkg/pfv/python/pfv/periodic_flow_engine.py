@@ -19,34 +19,12 @@ from yade.minieigenHP import Vector3
 from yade._packSpheres import SpherePack
 from yade.wrapper import PyRunner, Sphere
 
+from ._attributes import runner_attributes
 from ._core import PeriodicFlow, YadeForceBridge, gather_sphere_pack, sphere_pack_size
 
 _COMMAND = "__import__('pfv.periodic_flow_engine').periodic_flow_engine._run({})"
 _engines = weakref.WeakValueDictionary()  # key -> engine: the PyRunner commands find their engine here
 
-# YADE's PyRunner attributes, which this engine keeps as a PyRunner does.
-_RUNNER_ATTRIBUTES = frozenset(
-    {
-        "command",
-        "iterPeriod",
-        "virtPeriod",
-        "realPeriod",
-        "nDo",
-        "initRun",
-        "firstIterRun",
-        "iterLast",
-        "virtLast",
-        "realLast",
-        "nDone",
-        "dead",
-        "label",
-        "ignoreErrors",
-        "updateGlobals",
-        "timingDeltas",
-        "execCount",
-        "execTime",
-    }
-)
 # Members of YADE's FlowEngine that describe the walls of a box: a periodic cell has none.
 _WALLED_ONLY = frozenset(
     {
@@ -345,3 +323,8 @@ class PeriodicFlowEngine(PyRunner):
             self._remesh_asked = False
         self._bridge.apply(scene.forces.addF, self._core.forces())
         self._last_step = scene.iter
+
+
+# Kept as a PyRunner keeps them, but ompThreads: the periodic engine runs at the caller's thread count, and a setting
+# that did nothing would be silent.
+_RUNNER_ATTRIBUTES = runner_attributes(PyRunner, PeriodicFlowEngine) - {"ompThreads"}

@@ -12,9 +12,8 @@
 //
 // Cells whose power centres coincide (a throat of zero length: cospherical spheres, as in the
 // regular arrays) are one pore cut by arbitrary facets, and share one unknown: their throats have
-// no length, so no finite conductance is right for them. (Clamping them to 100 times the median,
-// as the walled engine and YADE do, makes the simple cubic array 1 % anisotropic and 3 % less
-// permeable than the same pores joined.)
+// no length, so no finite conductance is right for them (a clamped one leaves the arbitrary split
+// of each lattice cube into tetrahedra in the result: doc/periodic.md).
 #pragma once
 #include <memory>
 #include <vector>

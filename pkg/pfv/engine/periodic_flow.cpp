@@ -30,7 +30,7 @@ void PeriodicFlowSettings::validate() const {
   require(std::isfinite(bulk_modulus) && bulk_modulus >= 0, "fluidBulkModulus must be finite and not negative");
 }
 
-struct PeriodicFlow::Mesh {
+struct PeriodicFlow::Meshed {
   PeriodicTriangulation triangulation;
   CellGeometry cells;
   FacetGeometry facets;
@@ -137,7 +137,7 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
 
 void PeriodicFlow::remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
                           const Eigen::Matrix3d& h) {
-  auto next = std::make_unique<Mesh>();
+  auto next = std::make_unique<Meshed>();
   const PeriodicMesh& m = next->triangulation.build(centres, radii, PeriodicCell{h});
   static const BoxWalls no_walls{};
   const Packing packing{m.image_centre, m.image_radius, no_walls, &m.cell.h};
@@ -175,7 +175,7 @@ void PeriodicFlow::remesh(const std::vector<Vec3>& centres, const std::vector<do
 }
 
 void PeriodicFlow::build_system(double dt) {
-  Mesh& mesh = *mesh_;
+  Meshed& mesh = *mesh_;
   ConductanceModel model;
   model.viscosity = settings_.viscosity;
   model.permeability_factor = settings_.permeability_factor;

@@ -76,13 +76,13 @@ class PeriodicFlow {
   const std::vector<double>& fluid_volumes() const;
 
  private:
-  struct Mesh;
+  struct Meshed;  // what a remesh makes: triangulation, geometry, system, factor, force cache
   void remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const Eigen::Matrix3d& h);
   void build_system(double dt);
   void image_positions(const std::vector<Vec3>& centres, const Eigen::Matrix3d& h, std::vector<Vec3>& out) const;
 
   PeriodicFlowSettings settings_;
-  std::unique_ptr<Mesh> mesh_;
+  std::unique_ptr<Meshed> mesh_;
   bool remesh_due_ = true, system_due_ = true, source_due_ = true, has_previous_ = false;
   double system_dt_ = 0;
   int remeshes_ = 0;

@@ -591,12 +591,54 @@ def permeameter(flow, P, triax):
     return K, q_in, q_out
 
 
-def live_plot(plot):
-    """U and the mid-height pressure against T_v, shown and refreshed live by yade.plot."""
-    plot.plots = {'Tv': ('U_sim', 'U_theory'), 'Tv ': ('p_mid', 'p_mid_theory')}  # p_mid: / load
-    plot.plot(subPlots=True)
-    for a in {ref.line.axes for ref in plot.currLineRefs}:
-        a.set_xscale('log')
+class LivePlot:
+    """With the GUI, U and the mid-height pressure against T_v on fixed logarithmic axes, shown and refreshed live by
+    yade.plot's updater; headless, nothing.
+
+    plot.plot() would start its updater thread at once, and matplotlib is not thread-safe: a redraw racing with
+    set_xscale('log') meets the linear default limits (0, 1) and raises. So the figures are made without it, the axes
+    fixed, and the updater started here, on a thread that stop() joins before YADE leaves (a thread killed inside a
+    redraw at exit aborts the process)."""
+
+    def __init__(self, Tv_range):
+        self.plot = None
+        if HEADLESS:
+            return
+        import threading
+        from yade import plot
+
+        plot.plots = {'Tv': ('U_sim', 'U_theory'), 'Tv ': ('p_mid', 'p_mid_theory')}  # p_mid: / load
+        figures = plot.plot(subPlots=True, noShow=True)
+        self.figures = figures if isinstance(figures, list) else [figures]
+        self.axes = {ref.line.axes for ref in plot.currLineRefs}
+        for a in self.axes:
+            a.set_xscale('log')
+            a.set_xlim(*Tv_range)
+            a.set_autoscalex_on(False)
+        self.updater = threading.Thread(target=plot.liveUpdate, args=(time.time(),), daemon=True)
+        self.updater.start()
+        for f in self.figures:
+            f.show()
+        self.plot = plot
+
+    def add(self, **columns):
+        if self.plot:
+            self.plot.addData(**columns)
+
+    def stop(self):
+        """Stops the updater and draws the points it has not drawn yet."""
+        if not self.plot:
+            return
+        self.plot.live = False
+        self.updater.join()
+        self.plot.live = True
+        for ref in self.plot.currLineRefs:
+            ref.update()
+        for a in self.axes:
+            a.relim()
+            a.autoscale_view()
+        for f in self.figures:
+            f.canvas.draw_idle()
 
 
 def isochrone(flow, P, T_iso, row, sigma_eff_start, theories):
@@ -713,10 +755,7 @@ def run(opts):
     targets = sorted(set(list(np.geomspace(1e-3, P['Tv_end'], 60)) + list(P['isochrones'])))
     targets = [T for T in targets if T <= P['Tv_end'] * (1 + 1e-9)]
     iso_left = [T for T in P['isochrones'] if T <= P['Tv_end'] * (1 + 1e-9)]
-    if not HEADLESS:
-        from yade import plot
-
-        live_plot(plot)
+    live = LivePlot((0.8 * targets[0], 1.25 * targets[-1]))
     # drained volume: outflow through the drained walls, accumulated every step (fluid volume balance check)
     drained = [0.0]
     faces = [TOP] + ([BOTTOM] if P['drainage'] == 'both' else [])
@@ -759,14 +798,13 @@ def run(opts):
             settlement_volume=s * A,
         )
         rows.append(row)
-        if not HEADLESS:
-            plot.addData(
-                Tv=row['Tv'],
-                U_sim=row['U_sim'],
-                U_theory=row['U_theory'],
-                p_mid=p_mid / P['load'],
-                p_mid_theory=row['p_mid_theory'] / P['load'],
-            )
+        live.add(
+            Tv=row['Tv'],
+            U_sim=row['U_sim'],
+            U_theory=row['U_theory'],
+            p_mid=p_mid / P['load'],
+            p_mid_theory=row['p_mid_theory'] / P['load'],
+        )
         if iso_left and row['Tv'] >= iso_left[0] * (1 - 1e-9):
             iso += isochrone(flow, P, iso_left.pop(0), row, sigma_eff_start, (plain, layer))
         if len(rows) % 10 == 0 or T == targets[-1]:
@@ -781,6 +819,7 @@ def run(opts):
                     row['sigma_bottom_total'],
                 )
             )
+    live.stop()
     log(
         'engine %s: %d coupled steps in %.1f s (%.2f ms/step)'
         % (opts['engine'], O.iter - it0, wall_flow, 1e3 * wall_flow / max(1, O.iter - it0))

@@ -5,7 +5,8 @@
 Runs tests/pfv_testing/gui_oedometer_driver.py (which runs the example) with `xvfb-run -a yade-double -j1 -x` on the
 quick sample up to T_v = 0.2 (-x: YADE leaves after the script instead of opening its IPython prompt; stdin is /dev/null
 as well), then the same run headless, and checks:
-* the run completes (exit 0, within a timeout) in GUI mode (YADE saw a display);
+* the run completes (exit 0, within a timeout) in GUI mode (YADE saw a display), with no Python traceback printed
+  (a redraw of the live plot racing with its set-up once raised there, and a redraw killed at exit aborted YADE);
 * YADE's controller, its 3D view and the example's live matplotlib figure were on screen while the coupled phase ran;
 * the GUI stayed live during the run (the example steps in YADE's background thread and keeps processing Qt events):
   the driver's half-second timer fired while the iterations advanced and the live plot gained points;
@@ -53,6 +54,7 @@ def main():
         )
     print('\n'.join(line for line in text.splitlines() if line.startswith(('oedometer:', 'gui driver:'))))
     checks.check('GUI run completed (exit %s)' % code, code == 0)
+    checks.check('no Python traceback in the GUI run (live plot, Qt callbacks)', 'Traceback' not in text)
     gui_json = os.path.join(out, 'gui', 'gui.json')
     summary_path = os.path.join(out, 'gui', 'run', 'summary.json')
     if code != 0 or not os.path.exists(gui_json) or not os.path.exists(summary_path):

@@ -47,7 +47,7 @@ Darcy solve(const PeriodicPacking& p, const Vec3& gradient) {
     solver.setup(d.system.matrix, SolverOptions{});
     solver.solve(d.system.gather(d.source), x, SolveControl{});
   }
-  d.periodic_pressure = d.system.scatter(x);
+  d.periodic_pressure = d.system.scatter(x, std::vector<double>(m.n_cells(), 0.0));
   d.flux = periodic_fluxes(cells, d.facets, k, d.periodic_pressure, gradient);
   d.velocity = mean_velocity(cells, d.facets, d.flux, p.cell.volume());
   ForceCache cache;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "pfv/common/stage_timer.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
 #include "pfv/model/conductance.hpp"
 
@@ -20,6 +21,13 @@ double tetrahedron_volume(const std::array<int, 4>& v, const std::vector<Vec3>& 
   return (x[v[1]] - x[v[0]]).dot((x[v[2]] - x[v[0]]).cross(x[v[3]] - x[v[0]])) / 6.0;
 }
 
+void check_positions(const std::vector<Vec3>& centres, const Eigen::Matrix3d& h) {
+  require(h.allFinite() && h.determinant() > 0, "the cell's vectors (hSize) must be finite and right-handed");
+  require(!centres.empty(), "no spheres");
+  for (std::size_t s = 0; s < centres.size(); ++s)
+    require(centres[s].allFinite(), "sphere " + std::to_string(s) + " has a non-finite position");
+}
+
 }  // namespace
 
 void PeriodicFlowSettings::validate() const {
@@ -31,6 +39,10 @@ void PeriodicFlowSettings::validate() const {
 }
 
 struct PeriodicFlow::Meshed {
+  // The input, for run_state().
+  std::vector<Vec3> centres;
+  std::vector<double> radii;
+  Eigen::Matrix3d h;
   PeriodicTriangulation triangulation;
   CellGeometry cells;
   FacetGeometry facets;
@@ -41,6 +53,8 @@ struct PeriodicFlow::Meshed {
   ForceCache cache;
   PeriodicForces forces;
   std::unique_ptr<PressureSolver> solver;
+  // Per point condition, the cell holding its point (located when the system is built).
+  std::vector<int> pressure_cell, flux_cell;
 
   const PeriodicMesh& periodic() const { return triangulation.mesh(); }
 };
@@ -74,39 +88,44 @@ void PeriodicFlow::image_positions(const std::vector<Vec3>& centres, const Eigen
   }
 }
 
+void PeriodicFlow::check_mesh_input(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                                    const Eigen::Matrix3d& h) const {
+  check_positions(centres, h);
+  require(radii.size() == centres.size(),
+          std::to_string(radii.size()) + " radii for " + std::to_string(centres.size()) + " spheres");
+  double largest = 0;
+  for (std::size_t s = 0; s < radii.size(); ++s) {
+    require(std::isfinite(radii[s]) && radii[s] > 0,
+            "sphere " + std::to_string(s) + " has a radius that is not positive and finite");
+    largest = std::max(largest, radii[s]);
+  }
+  const PeriodicCell cell{h};
+  for (int a = 0; a < 3; ++a)
+    require(cell.width(a) >= kMinWidthInDiameters * 2 * largest,
+            "the periodic cell is " + std::to_string(cell.width(a)) + " thick across its vector " + std::to_string(a) +
+                ", less than " + std::to_string(kMinWidthInDiameters) + " diameters of its largest sphere (" +
+                std::to_string(2 * largest) + ")");
+}
+
 void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<double>& radii, const Eigen::Matrix3d& h,
                         double dt) {
+  const auto start = StageClock::now();
   // Everything checked before anything changes.
   require(std::isfinite(dt) && dt > 0, "the time step must be positive and finite");
-  require(h.allFinite() && h.determinant() > 0, "the cell's vectors (hSize) must be finite and right-handed");
-  require(!centres.empty(), "no spheres");
-  for (std::size_t s = 0; s < centres.size(); ++s)
-    require(centres[s].allFinite(), "sphere " + std::to_string(s) + " has a non-finite position");
+  check_positions(centres, h);
   const bool remeshing = remesh_due_ || !mesh_ || mesh_->periodic().n_spheres != static_cast<int>(centres.size());
   if (remeshing) {
-    require(radii.size() == centres.size(),
-            std::to_string(radii.size()) + " radii for " + std::to_string(centres.size()) + " spheres");
-    double largest = 0;
-    for (std::size_t s = 0; s < radii.size(); ++s) {
-      require(std::isfinite(radii[s]) && radii[s] > 0, "sphere " + std::to_string(s) +
-                                                           " has a radius that is not "
-                                                           "positive and finite");
-      largest = std::max(largest, radii[s]);
-    }
-    const PeriodicCell cell{h};
-    for (int a = 0; a < 3; ++a)
-      require(cell.width(a) >= kMinWidthInDiameters * 2 * largest,
-              "the periodic cell is " + std::to_string(cell.width(a)) + " thick across its vector " +
-                  std::to_string(a) + ", less than " + std::to_string(kMinWidthInDiameters) +
-                  " diameters of its largest sphere (" + std::to_string(2 * largest) + ")");
+    check_mesh_input(centres, radii, h);
     remesh(centres, radii, h);
   }
+  step_times_ = StageTimes{};
   if (system_due_ || (settings_.bulk_modulus > 0 && dt != system_dt_)) build_system(dt);
   if (source_due_) {
     mesh_->gradient_source = gradient_source(mesh_->cells, mesh_->facets, mesh_->conductance, settings_.gradient);
     source_due_ = false;
   }
 
+  auto t0 = StageClock::now();
   const PeriodicMesh& m = mesh_->periodic();
   const int nc = m.n_cells();
   image_positions(centres, h, images_);
@@ -116,29 +135,57 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
     volume[c] = mesh_->orientation[c] * tetrahedron_volume(m.mesh.cell_vertices[c], images_);
     if (has_previous_) volume_rate_[c] = (volume[c] - volume_[c]) / dt;
   }
+  step_times_.volumes = seconds_since(t0);
+  t0 = StageClock::now();
   std::vector<double> per_cell = mesh_->gradient_source;
   for (int c = 0; c < nc; ++c) {
     per_cell[c] -= volume_rate_[c];
     if (!storage_.empty()) per_cell[c] += storage_[c] * periodic_pressure_[c];
   }
+  for (std::size_t i = 0; i < imposed_flux_.size(); ++i) per_cell[mesh_->flux_cell[i]] += imposed_flux_[i].value;
   const PeriodicPressureSystem& system = mesh_->system;
+  const std::vector<double> known = known_pressures();
   std::vector<double> x = system.gather(periodic_pressure_);
-  if (system.n_unknowns() > 0) {  // else the cell is one pore, at its reference pressure
+  if (system.n_unknowns() > 0) {  // else every pore is known (the cell is one pore, or all imposed)
     std::vector<double> b = system.gather(per_cell);
+    system.add_known(known, b);
     mesh_->solver->solve(b, x, SolveControl{});
   }
-  periodic_pressure_ = system.scatter(x);
+  periodic_pressure_ = system.scatter(x, known);
+  step_times_.solve = seconds_since(t0);
+  t0 = StageClock::now();
   force_ = mesh_->forces.apply(mesh_->cache, m, pressure(), settings_.gradient, m.cell.h);
+  step_times_.forces = seconds_since(t0);
   volume_ = std::move(volume);
   centres_ = centres;
   h_ = h;
   has_previous_ = true;
+  step_times_.total = seconds_since(start);
 }
 
-void PeriodicFlow::remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
-                          const Eigen::Matrix3d& h) {
+std::vector<double> PeriodicFlow::known_pressures() const {
+  const PeriodicPressureSystem& system = mesh_->system;
+  std::vector<double> pore_value(mesh_->periodic().n_cells(), 0.0);
+  for (std::size_t i = 0; i < imposed_pressure_.size(); ++i)
+    pore_value[system.pore[mesh_->pressure_cell[i]]] =
+        imposed_pressure_[i].value - settings_.gradient.dot(imposed_pressure_[i].position);
+  std::vector<double> known(system.pore.size());
+  for (std::size_t c = 0; c < known.size(); ++c) known[c] = pore_value[system.pore[c]];
+  return known;
+}
+
+std::unique_ptr<PeriodicFlow::Meshed> PeriodicFlow::build_mesh(const std::vector<Vec3>& centres,
+                                                               const std::vector<double>& radii,
+                                                               const Eigen::Matrix3d& h) {
+  remesh_times_ = StageTimes{};
+  auto t0 = StageClock::now();
   auto next = std::make_unique<Meshed>();
+  next->centres = centres;
+  next->radii = radii;
+  next->h = h;
   const PeriodicMesh& m = next->triangulation.build(centres, radii, PeriodicCell{h});
+  remesh_times_.triangulation = seconds_since(t0);
+  t0 = StageClock::now();
   static const BoxWalls no_walls{};
   const Packing packing{m.image_centre, m.image_radius, no_walls, &m.cell.h};
   next->cells = compute_cell_geometry(m.mesh, packing);
@@ -146,10 +193,21 @@ void PeriodicFlow::remesh(const std::vector<Vec3>& centres, const std::vector<do
   next->orientation.resize(m.n_cells());
   for (int c = 0; c < m.n_cells(); ++c)
     next->orientation[c] = tetrahedron_volume(m.mesh.cell_vertices[c], m.image_centre) < 0 ? -1.0 : 1.0;
+  remesh_times_.geometry = seconds_since(t0);
+  t0 = StageClock::now();
   next->cache.build(m.mesh, next->facets, packing);
   next->forces.build(next->cache, m);
+  remesh_times_.force_cache = seconds_since(t0);
+  return next;
+}
+
+void PeriodicFlow::remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                          const Eigen::Matrix3d& h) {
+  auto next = build_mesh(centres, radii, h);
+  const PeriodicMesh& m = next->periodic();
   // The pressures carried over by position: each new cell takes the pressure p~ + gradP . x of
   // the old mesh at its power centre, less the gradient's part at the new centre.
+  const auto t0 = StageClock::now();
   std::vector<double> carried(m.n_cells(), 0.0);
   if (mesh_)
     for (int c = 0; c < m.n_cells(); ++c) {
@@ -157,24 +215,113 @@ void PeriodicFlow::remesh(const std::vector<Vec3>& centres, const std::vector<do
       carried[c] = pressure_at(x) - settings_.gradient.dot(x);
       if (!std::isfinite(carried[c])) carried[c] = 0.0;
     }
+  remesh_times_.carry_over = seconds_since(t0);
   const bool previous = has_previous_ && mesh_ && centres_.size() == centres.size();
   mesh_ = std::move(next);
   periodic_pressure_ = std::move(carried);
   // The reference of the next step's dV/dt: the new cells at the last step's positions.
   has_previous_ = previous;
+  if (previous) measure_previous_volumes();
+  remesh_due_ = false;
+  system_due_ = true;
+  ++remeshes_;
+}
+
+void PeriodicFlow::measure_previous_volumes() {
+  const PeriodicMesh& m = mesh_->periodic();
+  std::vector<Vec3> before;
+  image_positions(centres_, h_, before);
+  volume_.resize(m.n_cells());
+  for (int c = 0; c < m.n_cells(); ++c)
+    volume_[c] = mesh_->orientation[c] * tetrahedron_volume(m.mesh.cell_vertices[c], before);
+}
+
+PeriodicFlow::RunState PeriodicFlow::run_state() const {
+  if (!mesh_) throw std::logic_error("PeriodicFlow: no run state before the first step");
+  RunState state;
+  state.mesh_centres = mesh_->centres;
+  state.mesh_radii = mesh_->radii;
+  state.mesh_h = mesh_->h;
+  if (has_previous_) {
+    state.previous_centres = centres_;
+    state.previous_h = h_;
+  }
+  state.periodic_pressure = periodic_pressure_;
+  return state;
+}
+
+void PeriodicFlow::resume(const RunState& state) {
+  check_mesh_input(state.mesh_centres, state.mesh_radii, state.mesh_h);
+  const bool previous = !state.previous_centres.empty();
   if (previous) {
-    std::vector<Vec3> before;
-    image_positions(centres_, h_, before);
-    volume_.resize(m.n_cells());
-    for (int c = 0; c < m.n_cells(); ++c)
-      volume_[c] = mesh_->orientation[c] * tetrahedron_volume(m.mesh.cell_vertices[c], before);
+    require(state.previous_centres.size() == state.mesh_centres.size(),
+            "the run state's previous positions are not those of its mesh's spheres");
+    require(state.previous_h.allFinite() && state.previous_h.determinant() > 0,
+            "the run state's previous cell vectors must be finite and right-handed");
+    for (const Vec3& c : state.previous_centres) require(c.allFinite(), "the run state has a non-finite position");
+  }
+  auto next = build_mesh(state.mesh_centres, state.mesh_radii, state.mesh_h);
+  require(static_cast<int>(state.periodic_pressure.size()) == next->periodic().n_cells(),
+          "the run state's " + std::to_string(state.periodic_pressure.size()) + " pressures do not match the " +
+              std::to_string(next->periodic().n_cells()) + " cells of its rebuilt mesh");
+  for (double p : state.periodic_pressure) require(std::isfinite(p), "the run state has a non-finite pressure");
+  mesh_ = std::move(next);
+  periodic_pressure_ = state.periodic_pressure;
+  has_previous_ = previous;
+  if (previous) {
+    centres_ = state.previous_centres;
+    h_ = state.previous_h;
+    measure_previous_volumes();
   }
   remesh_due_ = false;
   system_due_ = true;
   ++remeshes_;
 }
 
+std::vector<int> PeriodicFlow::imposed_cells() const {
+  if (!mesh_) return {};
+  const std::vector<int>& pore = mesh_->system.pore;
+  std::vector<int> imposed_pore(pore.size(), 0), out(pore.size(), 0);
+  for (int c : mesh_->pressure_cell) imposed_pore[pore[c]] = 1;
+  for (std::size_t c = 0; c < pore.size(); ++c) out[c] = imposed_pore[pore[c]];
+  return out;
+}
+
+int PeriodicFlow::impose_pressure(const Vec3& pos, double p) {
+  require(pos.allFinite(), "imposePressure: the point must be finite");
+  require(std::isfinite(p), "imposePressure: the pressure must be finite");
+  imposed_pressure_.push_back({pos, p});
+  system_due_ = true;
+  return static_cast<int>(imposed_pressure_.size()) - 1;
+}
+
+void PeriodicFlow::set_imposed_pressure(int index, double p) {
+  if (index < 0 || index >= static_cast<int>(imposed_pressure_.size()))
+    throw std::out_of_range("setImposedPressure: no imposed pressure " + std::to_string(index) + " (there are " +
+                            std::to_string(imposed_pressure_.size()) + ")");
+  require(std::isfinite(p), "setImposedPressure: the pressure must be finite");
+  imposed_pressure_[index].value = p;
+}
+
+void PeriodicFlow::clear_imposed_pressure() {
+  if (!imposed_pressure_.empty()) system_due_ = true;
+  imposed_pressure_.clear();
+}
+
+void PeriodicFlow::impose_flux(const Vec3& pos, double inflow) {
+  require(pos.allFinite(), "imposeFlux: the point must be finite");
+  require(std::isfinite(inflow), "imposeFlux: the flux must be finite");
+  imposed_flux_.push_back({pos, inflow});
+  system_due_ = true;
+}
+
+void PeriodicFlow::clear_imposed_flux() {
+  imposed_flux_.clear();
+  system_due_ = true;
+}
+
 void PeriodicFlow::build_system(double dt) {
+  auto t0 = StageClock::now();
   Meshed& mesh = *mesh_;
   ConductanceModel model;
   model.viscosity = settings_.viscosity;
@@ -186,7 +333,21 @@ void PeriodicFlow::build_system(double dt) {
     for (std::size_t c = 0; c < storage_.size(); ++c)
       storage_[c] = mesh.cells.fluid_volume[c] / (settings_.bulk_modulus * dt);
   }
-  mesh.system = assemble_periodic_system(mesh.periodic().mesh, mesh.facets, mesh.conductance, storage_);
+  const auto locate = [&](const std::vector<PointCondition>& points, std::vector<int>& cell) {
+    cell.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      cell[i] = mesh.triangulation.locate(points[i].position).cell;
+      if (cell[i] < 0) throw std::logic_error("PeriodicFlow: a condition's point is in no cell of the mesh");
+    }
+  };
+  locate(imposed_pressure_, mesh.pressure_cell);
+  locate(imposed_flux_, mesh.flux_cell);
+  step_times_.conductance = seconds_since(t0);
+  t0 = StageClock::now();
+  mesh.system =
+      assemble_periodic_system(mesh.periodic().mesh, mesh.facets, mesh.conductance, storage_, mesh.pressure_cell);
+  step_times_.assembly = seconds_since(t0);
+  t0 = StageClock::now();
   mesh.solver.reset();
   if (mesh.system.n_unknowns() > 0) {
     // METIS orders the periodic graph as it is; the geometric dissection cuts by planes, which
@@ -196,6 +357,7 @@ void PeriodicFlow::build_system(double dt) {
     mesh.solver = std::make_unique<CholeskySolver>();
     mesh.solver->setup(mesh.system.matrix, options);
   }
+  step_times_.factorization = seconds_since(t0);
   system_dt_ = dt;
   system_due_ = false;
   source_due_ = true;  // new conductances
@@ -218,6 +380,11 @@ double PeriodicFlow::pressure_at(const Vec3& x) const {
   const auto where = mesh_->triangulation.locate(x);
   if (where.cell < 0) return std::numeric_limits<double>::quiet_NaN();
   return periodic_pressure_[where.cell] + settings_.gradient.dot(x);
+}
+
+const CellGeometry& PeriodicFlow::cells() const {
+  if (!mesh_) throw std::logic_error("PeriodicFlow: no mesh before the first step");
+  return mesh_->cells;
 }
 
 const std::vector<double>& PeriodicFlow::fluid_volumes() const {

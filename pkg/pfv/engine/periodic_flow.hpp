@@ -14,7 +14,9 @@
 #include <memory>
 #include <vector>
 
+#include "pfv/engine/stage_times.hpp"
 #include "pfv/linalg/pressure_solver.hpp"
+#include "pfv/model/boundary_conditions.hpp"
 #include "pfv/model/force_cache.hpp"
 #include "pfv/model/periodic_forces.hpp"
 #include "pfv/model/periodic_pressure_system.hpp"
@@ -49,6 +51,25 @@ class PeriodicFlow {
   void set_settings(const PeriodicFlowSettings& settings);
   const PeriodicFlowSettings& settings() const { return settings_; }
 
+  // Point conditions (YADE's imposePressure, imposeFlux), kept through remeshes: each acts on
+  // the pore holding its point, located at the remesh (any point, in any period). An imposed
+  // pressure p sets the pore's p~ to p - gradP . pos, so that pressure_at(pos) is p; it fixes
+  // the constant of p~ in place of the reference pore. Of two in one pore the later one holds.
+  // A flux adds an inflow (volume per time) to its pore; incompressible and with no imposed
+  // pressure, the reference pore takes the net inflow. Adding or clearing takes effect at the
+  // next step (a new factor); set_imposed_pressure changes a value only. Throws
+  // std::invalid_argument for a point or value that is not finite, std::out_of_range for an
+  // index that is not a condition.
+  int impose_pressure(const Vec3& pos, double p);
+  void set_imposed_pressure(int index, double p);
+  void clear_imposed_pressure();
+  void impose_flux(const Vec3& pos, double inflow);
+  void clear_imposed_flux();
+  const std::vector<PointCondition>& imposed_pressures() const { return imposed_pressure_; }
+  const std::vector<PointCondition>& imposed_fluxes() const { return imposed_flux_; }
+  // Per cell of the mesh, 1 where an imposed pressure holds its pore (after a step), else 0.
+  std::vector<int> imposed_cells() const;
+
   // Asks for a new mesh at the next step.
   void request_remesh() { remesh_due_ = true; }
   // The next step has no dV/dt term: the positions of the last step are not where this one's
@@ -67,18 +88,55 @@ class PeriodicFlow {
   std::vector<double> pressure() const;
   const std::vector<double>& volume_rates() const { return volume_rate_; }
   const std::vector<Vec3>& forces() const { return force_; }  // per sphere
+  // The last step's positions of the mesh's images (PeriodicMesh::image_sphere), and the stored
+  // cells' volumes at them.
+  const std::vector<Vec3>& image_positions() const { return images_; }
+  const Eigen::Matrix3d& step_cell() const { return h_; }  // the cell's vectors of the last step
+  const std::vector<double>& current_volumes() const { return volume_; }
   // The superficial velocity (1/V) sum_f q_f d_f.
   Vec3 mean_velocity() const;
   // The pressure p~ + gradP . x at x (anywhere), or NaN before the first step.
   double pressure_at(const Vec3& x) const;
   int remesh_count() const { return remeshes_; }
+  // Seconds per stage of the last remesh (triangulation, geometry, force_cache, conductance,
+  // assembly, factorization: ordering included) and of the last step (volumes, solve, forces,
+  // total: the remesh included if the step made one).
+  const StageTimes& remesh_times() const { return remesh_times_; }
+  const StageTimes& step_times() const { return step_times_; }
+
+  // What a run needs to go on exactly where it stopped (a saved and reloaded scene): the input
+  // of the current mesh, the last step's positions and cell, and p~. resume() rebuilds the same
+  // mesh (the triangulation is a function of its input) and restores the rest, so that the next
+  // step equals the uninterrupted run's, cells numbered as before.
+  struct RunState {
+    std::vector<Vec3> mesh_centres;
+    std::vector<double> mesh_radii;
+    Eigen::Matrix3d mesh_h = Eigen::Matrix3d::Identity();
+    std::vector<Vec3> previous_centres;  // empty: no dV/dt history
+    Eigen::Matrix3d previous_h = Eigen::Matrix3d::Identity();
+    std::vector<double> periodic_pressure;  // per cell of the mesh
+  };
+  RunState run_state() const;  // needs a mesh
+  // Throws std::invalid_argument for a state whose input a step would refuse, or whose pressures
+  // do not match the rebuilt mesh; the engine is then left as it was.
+  void resume(const RunState& state);
   // Per stored cell, its fluid volume at the remesh (what the storage of a compressible fluid uses).
   const std::vector<double>& fluid_volumes() const;
+  // The stored cells' geometry at the remesh (volumes, power centres); needs a mesh.
+  const CellGeometry& cells() const;
 
  private:
   struct Meshed;  // what a remesh makes: triangulation, geometry, system, factor, force cache
+  void check_mesh_input(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                        const Eigen::Matrix3d& h) const;
+  std::unique_ptr<Meshed> build_mesh(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                                     const Eigen::Matrix3d& h);
   void remesh(const std::vector<Vec3>& centres, const std::vector<double>& radii, const Eigen::Matrix3d& h);
   void build_system(double dt);
+  // volume_ of the current mesh's cells at the last step's positions (centres_, h_).
+  void measure_previous_volumes();
+  // Per cell, the known p~ of the reference pore (0) and of the imposed pores; the rest 0.
+  std::vector<double> known_pressures() const;
   void image_positions(const std::vector<Vec3>& centres, const Eigen::Matrix3d& h, std::vector<Vec3>& out) const;
 
   PeriodicFlowSettings settings_;
@@ -90,6 +148,8 @@ class PeriodicFlow {
   std::vector<Vec3> centres_, images_;  // the last step's
   std::vector<double> volume_, volume_rate_, periodic_pressure_, storage_;
   std::vector<Vec3> force_;
+  std::vector<PointCondition> imposed_pressure_, imposed_flux_;
+  StageTimes remesh_times_, step_times_;
 };
 
 }  // namespace pfv

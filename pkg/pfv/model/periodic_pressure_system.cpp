@@ -34,22 +34,29 @@ std::vector<double> PeriodicPressureSystem::gather(const std::vector<double>& pe
   return b;
 }
 
-std::vector<double> PeriodicPressureSystem::scatter(const std::vector<double>& x) const {
+void PeriodicPressureSystem::add_known(const std::vector<double>& periodic_pressure, std::vector<double>& b) const {
+  for (const Coupling& c : coupling) b[c.unknown] += c.k * periodic_pressure[c.cell];
+}
+
+std::vector<double> PeriodicPressureSystem::scatter(const std::vector<double>& x,
+                                                    const std::vector<double>& known) const {
   std::vector<double> per_cell(unknown.size(), 0.0);
-  for (std::size_t c = 0; c < unknown.size(); ++c)
-    if (unknown[c] >= 0) per_cell[c] = x[unknown[c]];
+  for (std::size_t c = 0; c < unknown.size(); ++c) per_cell[c] = unknown[c] >= 0 ? x[unknown[c]] : known[c];
   return per_cell;
 }
 
 PeriodicPressureSystem assemble_periodic_system(const Mesh& mesh, const FacetGeometry& facets,
-                                                const std::vector<double>& k, const std::vector<double>& storage) {
+                                                const std::vector<double>& k, const std::vector<double>& storage,
+                                                const std::vector<int>& imposed) {
   require_periodic(facets, k, "assemble_periodic_system");
   const int n = mesh.n_cells();
   if (n < 1) throw std::invalid_argument("assemble_periodic_system: no cells");
   if (!storage.empty() && static_cast<int>(storage.size()) != n)
     throw std::invalid_argument("assemble_periodic_system: one storage value per cell is needed");
+  for (int c : imposed)
+    if (c < 0 || c >= n) throw std::invalid_argument("assemble_periodic_system: an imposed cell is not a cell");
   PeriodicPressureSystem s;
-  if (!storage.empty()) s.reference_cell = -1;
+  if (!storage.empty() || !imposed.empty()) s.reference_cell = -1;
   // Pores: the cells joined by zero-length throats.
   std::vector<int> parent(n);
   for (int c = 0; c < n; ++c) parent[c] = c;
@@ -57,10 +64,17 @@ PeriodicPressureSystem assemble_periodic_system(const Mesh& mesh, const FacetGeo
     if (facets.length[f] == 0) parent[find_root(parent, facets.cell[f][0])] = find_root(parent, facets.cell[f][1]);
   s.unknown.assign(n, -1);
   std::vector<int> root_unknown(n, -1);
-  const int reference_root = s.reference_cell < 0 ? -1 : find_root(parent, s.reference_cell);
+  std::vector<char> known_root(n, 0);
+  if (s.reference_cell >= 0) known_root[find_root(parent, s.reference_cell)] = 1;
+  for (int c : imposed) known_root[find_root(parent, c)] = 1;
+  s.pore.assign(n, -1);
+  std::vector<int> root_pore(n, -1);
+  int pores = 0;
   for (int c = 0; c < n; ++c) {
     const int r = find_root(parent, c);
-    if (r == reference_root) continue;
+    if (root_pore[r] < 0) root_pore[r] = pores++;
+    s.pore[c] = root_pore[r];
+    if (known_root[r]) continue;
     if (root_unknown[r] < 0) {
       root_unknown[r] = static_cast<int>(s.unknown_cell.size());
       s.unknown_cell.push_back(c);
@@ -75,11 +89,15 @@ PeriodicPressureSystem assemble_periodic_system(const Mesh& mesh, const FacetGeo
   for (int f = 0; f < facets.size(); ++f) {
     const int a = facets.cell[f][0], b = facets.cell[f][1];
     const int ua = s.unknown[a], ub = s.unknown[b];
-    if (ua == ub) continue;  // within one pore (or one pore and its translate): a source only
+    if (ua == ub) continue;  // within one pore (or one pore and its translate), or two known: a source only
     if (ua >= 0) diagonal[ua] += k[f];
     if (ub >= 0) diagonal[ub] += k[f];
     if (ua >= 0 && ub >= 0)
       entries.emplace_back(static_cast<long long>(std::max(ua, ub)) * m + std::min(ua, ub), -k[f]);
+    else if (ua >= 0)
+      s.coupling.push_back({ua, b, k[f]});
+    else if (ub >= 0)
+      s.coupling.push_back({ub, a, k[f]});
   }
   if (!storage.empty())
     for (int c = 0; c < n; ++c) diagonal[s.unknown[c]] += storage[c];

@@ -10,12 +10,8 @@ namespace pfv::python {
 
 void bind_geometry(EngineClass& engine) {
   engine
-      .def("cell_vertices", exclusive([](const SharedEngine& e) {
-             const auto& cv = meshed(e).mesh().cell_vertices;
-             py::array_t<int> out({static_cast<py::ssize_t>(cv.size()), py::ssize_t{4}});
-             if (!cv.empty()) std::memcpy(out.mutable_data(), cv.data(), cv.size() * sizeof(cv[0]));
-             return out;
-           }))
+      .def("cell_vertices",
+           exclusive([](const SharedEngine& e) { return cell_vertices_array(meshed(e).mesh().cell_vertices); }))
       .def("cell_volumes", exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).cells().volume); }))
       .def("cell_fluid_volumes",
            exclusive([](const SharedEngine& e) { return vector_to_array(meshed(e).cells().fluid_volume); }))

@@ -19,6 +19,29 @@ Eigen::Matrix3d to_cell(const Array& h) {
   return out;
 }
 
+py::dict to_dict(const PeriodicFlow::RunState& s) {
+  py::dict d;
+  d["mesh_centres"] = points_to_array(s.mesh_centres);
+  d["mesh_radii"] = vector_to_array(s.mesh_radii);
+  d["mesh_h"] = s.mesh_h;
+  d["previous_centres"] = points_to_array(s.previous_centres);
+  d["previous_h"] = s.previous_h;
+  d["periodic_pressure"] = vector_to_array(s.periodic_pressure);
+  return d;
+}
+
+PeriodicFlow::RunState from_dict(const py::dict& d) {
+  PeriodicFlow::RunState s;
+  s.mesh_centres = to_points(d["mesh_centres"].cast<Array>(), "mesh_centres");
+  s.mesh_radii = to_vector(d["mesh_radii"].cast<Array>(), "mesh_radii");
+  s.mesh_h = to_cell(d["mesh_h"].cast<Array>());
+  const Array previous = d["previous_centres"].cast<Array>();
+  if (previous.size() > 0) s.previous_centres = to_points(previous, "previous_centres");
+  s.previous_h = to_cell(d["previous_h"].cast<Array>());
+  s.periodic_pressure = to_vector(d["periodic_pressure"].cast<Array>(), "periodic_pressure");
+  return s;
+}
+
 }  // namespace
 
 void bind_periodic(py::module_& m) {
@@ -48,6 +71,22 @@ void bind_periodic(py::module_& m) {
           },
           py::arg("centres"), py::arg("radii"), py::arg("h"), py::arg("dt"),
           "One step: centres (n, 3), radii (n,), the cell's vectors h (3, 3, columns as YADE's hSize), dt.")
+      .def("impose_pressure", &PeriodicFlow::impose_pressure, py::arg("position"), py::arg("pressure"),
+           "An imposed pressure at the pore holding position (kept through remeshes); returns its index.")
+      .def("set_imposed_pressure", &PeriodicFlow::set_imposed_pressure, py::arg("index"), py::arg("pressure"))
+      .def("clear_imposed_pressure", &PeriodicFlow::clear_imposed_pressure)
+      .def("impose_flux", &PeriodicFlow::impose_flux, py::arg("position"), py::arg("inflow"),
+           "An inflow (volume per time) into the pore holding position (kept through remeshes).")
+      .def("clear_imposed_flux", &PeriodicFlow::clear_imposed_flux)
+      .def("imposed_pressures", [](const PeriodicFlow& f) { return conditions(f.imposed_pressures()); })
+      .def("imposed_fluxes", [](const PeriodicFlow& f) { return conditions(f.imposed_fluxes()); })
+      .def("imposed_cells", [](const PeriodicFlow& f) { return vector_to_array(f.imposed_cells()); })
+      .def("run_state", [](const PeriodicFlow& f) { return to_dict(f.run_state()); })
+      .def(
+          "resume", [](PeriodicFlow& f, const py::dict& state) { f.resume(from_dict(state)); }, py::arg("state"),
+          "Rebuild the mesh and the history of run_state() (PeriodicFlow::resume).")
+      .def("remesh_times", [](const PeriodicFlow& f) { return times_dict(f.remesh_times()); })
+      .def("step_times", [](const PeriodicFlow& f) { return times_dict(f.step_times()); })
       .def("request_remesh", &PeriodicFlow::request_remesh)
       .def("forget_motion", &PeriodicFlow::forget_motion)
       .def("has_mesh", &PeriodicFlow::has_mesh)
@@ -57,6 +96,12 @@ void bind_periodic(py::module_& m) {
       .def("pressure", [](const PeriodicFlow& f) { return vector_to_array(f.pressure()); })
       .def("volume_rates", [](const PeriodicFlow& f) { return vector_to_array(f.volume_rates()); })
       .def("fluid_volumes", [](const PeriodicFlow& f) { return vector_to_array(f.fluid_volumes()); })
+      .def("cell_volumes", [](const PeriodicFlow& f) { return vector_to_array(f.cells().volume); })
+      .def("cell_vertices", [](const PeriodicFlow& f) { return cell_vertices_array(f.mesh().mesh.cell_vertices); })
+      .def("image_spheres", [](const PeriodicFlow& f) { return vector_to_array(f.mesh().image_sphere); })
+      .def("image_positions", [](const PeriodicFlow& f) { return points_to_array(f.image_positions()); })
+      .def("step_cell", [](const PeriodicFlow& f) { return Eigen::Matrix3d(f.step_cell()); })
+      .def("current_cell_volumes", [](const PeriodicFlow& f) { return vector_to_array(f.current_volumes()); })
       .def("forces", [](const PeriodicFlow& f) { return points_to_array(f.forces()); })
       .def("mean_velocity", &PeriodicFlow::mean_velocity)
       .def("pressure_at", &PeriodicFlow::pressure_at, py::arg("x"));

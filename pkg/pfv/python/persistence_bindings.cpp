@@ -66,13 +66,6 @@ FlowEngine::RunState from_dict(const py::dict& d) {
   return s;
 }
 
-py::list conditions(const std::vector<PointCondition>& list) {
-  py::list out;
-  for (const PointCondition& c : list)
-    out.append(py::make_tuple(py::make_tuple(c.position.x(), c.position.y(), c.position.z()), c.value));
-  return out;
-}
-
 }  // namespace
 
 void bind_persistence(EngineClass& engine) {

@@ -27,26 +27,6 @@ using namespace pfv;
 using namespace pfv::python;
 
 namespace {
-py::dict times_dict(const StageTimes& t) {
-  py::dict d;
-  d["triangulation"] = t.triangulation;
-  d["geometry"] = t.geometry;
-  d["conductance"] = t.conductance;
-  d["assembly"] = t.assembly;
-  d["analysis"] = t.analysis;
-  d["factorization"] = t.factorization;
-  d["force_cache"] = t.force_cache;
-  d["volumes"] = t.volumes;
-  d["solve"] = t.solve;
-  d["forces"] = t.forces;
-  d["shear_geometry"] = t.shear_geometry;
-  d["shear_forces"] = t.shear_forces;
-  d["pressure_field"] = t.pressure_field;
-  d["carry_over"] = t.carry_over;
-  d["total"] = t.total;
-  return d;
-}
-
 // Applies an edit to a copy of the settings, validated by the core before it is kept.
 template <class Edit>
 void update(FlowEngine& e, Edit edit) {

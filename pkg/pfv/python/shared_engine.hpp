@@ -23,6 +23,13 @@ namespace py = pybind11;
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
+// The stage times of a remesh or step as a dict (stage -> seconds).
+py::dict times_dict(const StageTimes& t);
+// Point conditions as [((x, y, z), value), ...].
+py::list conditions(const std::vector<PointCondition>& list);
+// Four vertex indices per cell as an (n, 4) array.
+py::array_t<int> cell_vertices_array(const std::vector<std::array<int, 4>>& cells);
+
 inline std::vector<Vec3> to_points(const Array& a, const char* name) {
   if (a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(std::string(name) + " must have shape (n, 3)");
   std::vector<Vec3> out(a.shape(0));

@@ -269,3 +269,22 @@ def runner_attributes(runner: type, engine: type) -> frozenset[str]:
     return frozenset(
         a for a in dir(runner) if not a.startswith("_") and not callable(getattr(runner, a)) and a not in vars(engine)
     )
+
+
+# The PyRunner attributes of an engine's schedule, which YADE saves and restores with the scene (an engine rebuilt
+# after O.load takes them from the restored PyRunner).
+RUNNER_SCHEDULE = (
+    "iterPeriod",
+    "virtPeriod",
+    "realPeriod",
+    "nDo",
+    "initRun",
+    "firstIterRun",
+    "iterLast",
+    "virtLast",
+    "realLast",
+    "nDone",
+    "dead",
+    "ignoreErrors",
+    "updateGlobals",
+)

@@ -1,4 +1,4 @@
-"""O.save / O.load of a scene with a pfv.FlowEngine: the engine goes on where it stopped.
+"""O.save / O.load of a scene with a pfv.FlowEngine or pfv.PeriodicFlowEngine: the engine goes on where it stopped.
 
 YADE saves a ``PyRunner`` subclass as a plain ``PyRunner`` (its command, label and schedule, nothing
 of the Python object), and restores it so. PFV therefore wraps YADE's ``save``/``saveTmp``/
@@ -6,7 +6,7 @@ of the Python object), and restores it so. PFV therefore wraps YADE's ``save``/`
 engine in ``O.engines`` writes its settings and its run state (the positions its mesh was built
 from, the positions and pressures of its last step, the remesh schedule) into a tag of the scene,
 ``O.tags["pfv.saved.<i>"]`` for the engine at ``O.engines[i]``; after a load, every plain
-``PyRunner`` with PFV's command and such a tag is replaced by a new ``pfv.FlowEngine`` rebuilt from
+``PyRunner`` with PFV's command and such a tag is replaced by a new engine of its class rebuilt from
 it (which rebuilds the same mesh: the triangulation is a function of its input), and its label is
 bound to it. The next step then equals the uninterrupted run's. A tag is emptied once used; arrays
 travel as base64 of their float64 bytes, bit for bit.
@@ -61,10 +61,17 @@ def _decode(value: Any) -> Any:
     return value
 
 
-def _flow_engine_class() -> type:
+def _engine_classes() -> tuple[type, ...]:
+    """The engine classes whose state a scene carries; each has drives(command), _saved_state() and
+    _from_saved(state, runner)."""
     from .flow_engine import FlowEngine  # circular at import time: flow_engine installs this module
+    from .periodic_flow_engine import PeriodicFlowEngine
 
-    return FlowEngine
+    return FlowEngine, PeriodicFlowEngine
+
+
+def _class_driving(command: str) -> type | None:
+    return next((cls for cls in _engine_classes() if cls.drives(command)), None)
 
 
 def _due_again(runner: PyRunner) -> int | None:
@@ -79,29 +86,30 @@ def _due_again(runner: PyRunner) -> int | None:
 
 
 def _before_save() -> None:
-    cls = _flow_engine_class()
+    classes = _engine_classes()
     tags = yade.O.tags
     for key in tags.keys():  # an earlier save's, for engines no longer there
         if key.startswith(TAG):
             tags[key] = ""
     for i, engine in enumerate(yade.O.engines):
-        if isinstance(engine, cls):
+        if isinstance(engine, classes):
             tags[TAG + str(i)] = json.dumps(_encode(engine._saved_state()))
 
 
-def _restored_runners(engines: list[Any]) -> list[tuple[int, PyRunner, str]]:
-    """(index, runner, saved state) of the plain PyRunners of `engines` that stand for a pfv engine."""
-    cls = _flow_engine_class()
+def _restored_runners(engines: list[Any]) -> list[tuple[int, PyRunner, str, type]]:
+    """(index, runner, saved state, engine class) of the plain PyRunners of `engines` that stand for a pfv
+    engine."""
     found = []
     for i, runner in enumerate(engines):
-        if type(runner) is not PyRunner or not cls.drives(runner.command):
+        cls = _class_driving(runner.command) if type(runner) is PyRunner else None
+        if cls is None:
             continue
         try:
             text = yade.O.tags[TAG + str(i)]
         except KeyError:
             continue
         if text:
-            found.append((i, runner, text))
+            found.append((i, runner, text, cls))
     return found
 
 
@@ -114,27 +122,27 @@ def _settings_of_label(runner: PyRunner) -> dict[str, Any]:
     return dict(vars(bound))
 
 
-def _rebuilt(state: dict[str, Any], runner: PyRunner) -> Any:
-    """The engine for `runner`, with the settings made on its label before pfv took it over."""
-    engine = _flow_engine_class()._from_saved(state, runner)
+def _rebuilt(state: dict[str, Any], runner: PyRunner, cls: type) -> Any:
+    """The engine of class `cls` for `runner`, with the settings made on its label before pfv took it over."""
+    engine = cls._from_saved(state, runner)
     for name, value in _settings_of_label(runner).items():
         try:
             setattr(engine, name, value)
         except Exception as error:
             raise type(error)(
-                f"pfv.FlowEngine '{runner.label}': {name} = {value!r}, set on the plain PyRunner YADE restored "
+                f"pfv.{cls.__name__} '{runner.label}': {name} = {value!r}, set on the plain PyRunner YADE restored "
                 f"before pfv was imported, is refused: {error} (import pfv before O.load)"
             ) from None
     return engine
 
 
 def adopt_restored(loaded: bool = False) -> None:
-    """Put a pfv.FlowEngine rebuilt from its saved state in place of every plain PyRunner that stands for
+    """Put a pfv engine rebuilt from its saved state in place of every plain PyRunner that stands for
     one, and bind the labels to them. Each engine is built before any is put in place: a setting refused
     leaves the scene as it was. `loaded`: the scene was loaded and has not run since (not from a step)."""
     engines = list(yade.O.engines)
     restored = _restored_runners(engines)
-    rebuilt = [(i, runner, _rebuilt(_decode(json.loads(text)), runner)) for i, runner, text in restored]
+    rebuilt = [(i, runner, _rebuilt(_decode(json.loads(text)), runner, cls)) for i, runner, text, cls in restored]
     if not rebuilt:
         return
     for i, runner, engine in rebuilt:
@@ -154,7 +162,7 @@ def adopt_restored(loaded: bool = False) -> None:
 
 
 def engine_for(command: str) -> Any:
-    """The pfv.FlowEngine that stands for the plain PyRunner running `command` (all of the scene's taken
+    """The pfv engine that stands for the plain PyRunner running `command` (all of the scene's taken
     over now), or None without a saved state."""
     adopt_restored()
     engine = _adopted.get(command)

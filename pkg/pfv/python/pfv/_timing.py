@@ -24,6 +24,9 @@ _REMESH_STAGES = (
     ("carry_over", "remesh: pressures carried over"),
 )
 _STEP_STAGES = (
+    ("conductance", "system: conductances"),  # a system rebuilt by the step without a remesh (periodic engine)
+    ("assembly", "system: assembly"),
+    ("factorization", "system: factorization"),
     ("volumes", "dV/dt"),
     ("pressure_field", "boundary pressure"),
     ("solve", "solve"),

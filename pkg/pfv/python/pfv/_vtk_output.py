@@ -45,7 +45,18 @@ from vtkmodules.vtkCommonDataModel import (
 )
 from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridWriter
 
-__all__ = ["FlowState", "read_state", "pore_grid", "sphere_grid", "write_grid", "save", "COLLECTION"]
+__all__ = [
+    "FlowState",
+    "read_state",
+    "pore_grid",
+    "sphere_grid",
+    "unstructured_grid",
+    "vtk_array",
+    "write_grid",
+    "save",
+    "save_grids",
+    "COLLECTION",
+]
 
 COLLECTION = "out.pvd"  # the collection file of a folder
 _WALLS = 6
@@ -99,7 +110,7 @@ def read_state(core: Any, ids: np.ndarray, radii: np.ndarray, wall_ids: list[int
 
 # The VTK arrays are copies: a VTK array sharing a numpy array's memory keeps it alive only through its Python
 # wrapper, which VTK may drop while the C++ array lives on in the grid (then pointing to freed memory).
-def _vtk_array(values: np.ndarray, name: str) -> Any:
+def vtk_array(values: np.ndarray, name: str) -> Any:
     """A named VTK array with a copy of `values` (one memcpy)."""
     array = numpy_to_vtk(np.ascontiguousarray(values), deep=True)
     array.SetName(name)
@@ -110,17 +121,17 @@ def _id_array(values: np.ndarray) -> Any:
     return numpy_to_vtk(np.ascontiguousarray(values, dtype=np.int64), deep=True, array_type=VTK_ID_TYPE)
 
 
-def _grid(
+def unstructured_grid(
     points: np.ndarray, cell_types: np.ndarray, offsets: np.ndarray, connectivity: np.ndarray, time: float
 ) -> vtkUnstructuredGrid:
     grid = vtkUnstructuredGrid()
     vtk_points = vtkPoints()
-    vtk_points.SetData(_vtk_array(np.asarray(points, dtype=float), "Points"))
+    vtk_points.SetData(vtk_array(np.asarray(points, dtype=float), "Points"))
     grid.SetPoints(vtk_points)
     cells = vtkCellArray()
     cells.SetData(_id_array(offsets), _id_array(connectivity))
-    grid.SetCells(_vtk_array(cell_types, "types"), cells)
-    grid.GetFieldData().AddArray(_vtk_array(np.array([time]), "TimeValue"))
+    grid.SetCells(vtk_array(cell_types, "types"), cells)
+    grid.GetFieldData().AddArray(vtk_array(np.array([time]), "TimeValue"))
     return grid
 
 
@@ -257,7 +268,7 @@ def _pore_cells(state: FlowState, with_boundaries: bool) -> tuple[np.ndarray, ..
 def pore_grid(state: FlowState, with_boundaries: bool) -> vtkUnstructuredGrid:
     """The pore network as a VTK unstructured grid (see the module's docstring)."""
     kept, points, types, offsets, connectivity = _pore_cells(state, with_boundaries)
-    grid = _grid(points, types, offsets, connectivity, state.time)
+    grid = unstructured_grid(points, types, offsets, connectivity, state.time)
     source = np.asarray(state.source, dtype=np.int32)[kept]
     fictious = (np.asarray(state.cell_vertices) >= state.n_spheres).sum(axis=1).astype(np.int32)[kept]
     data = grid.GetCellData()
@@ -271,7 +282,7 @@ def pore_grid(state: FlowState, with_boundaries: bool) -> vtkUnstructuredGrid:
         ("fictious", fictious),
         ("id", kept.astype(np.int32)),
     ):
-        data.AddArray(_vtk_array(values, name))
+        data.AddArray(vtk_array(values, name))
     data.SetActiveScalars("Pressure")
     return grid
 
@@ -280,7 +291,7 @@ def sphere_grid(state: FlowState) -> vtkUnstructuredGrid:
     """The coupled spheres as VTK vertices with their radii, YADE ids and fluid forces; the walls' ids, positions and
     fluid forces as field data."""
     n = state.n_spheres
-    grid = _grid(
+    grid = unstructured_grid(
         state.positions,
         np.full(n, VTK_VERTEX, dtype=np.uint8),
         np.arange(n + 1, dtype=np.int64),
@@ -289,14 +300,14 @@ def sphere_grid(state: FlowState) -> vtkUnstructuredGrid:
     )
     forces = np.asarray(state.forces, dtype=float)
     data = grid.GetPointData()
-    data.AddArray(_vtk_array(state.radii, "radii"))
-    data.AddArray(_vtk_array(state.ids, "id"))
-    data.AddArray(_vtk_array(forces[:n], "fluidForce"))
+    data.AddArray(vtk_array(state.radii, "radii"))
+    data.AddArray(vtk_array(state.ids, "id"))
+    data.AddArray(vtk_array(forces[:n], "fluidForce"))
     data.SetActiveScalars("radii")
     field = grid.GetFieldData()
-    field.AddArray(_vtk_array(state.wall_ids, "wallIds"))
-    field.AddArray(_vtk_array(state.walls, "wallPositions"))
-    field.AddArray(_vtk_array(forces[n : n + _WALLS], "wallFluidForce"))
+    field.AddArray(vtk_array(state.wall_ids, "wallIds"))
+    field.AddArray(vtk_array(state.walls, "wallPositions"))
+    field.AddArray(vtk_array(forces[n : n + _WALLS], "wallFluidForce"))
     return grid
 
 
@@ -356,17 +367,26 @@ def _write_collection(folder: str, snapshots: list[_Snapshot]) -> None:
     os.replace(partial, path)
 
 
-def save(state: FlowState, folder: str, with_boundaries: bool, compress: bool) -> list[str]:
-    """Write the snapshot `state` into `folder` (made if missing) as out_<N>.vtu and spheres_<N>.vtu, N the number
-    of snapshots this process wrote there before, and rewrite the folder's collection. Returns the paths written."""
+def save_grids(
+    folder: str, time: float, grids: list[tuple[str, str, vtkUnstructuredGrid]], compress: bool
+) -> list[str]:
+    """Write the parts `grids` ((name, file prefix, grid) each) of one snapshot at `time` into `folder` (made if
+    missing) as <prefix>_<N>.vtu, N the number of snapshots this process wrote there before, and rewrite the folder's
+    collection. Returns the paths written."""
     os.makedirs(folder, exist_ok=True)
     key = os.path.realpath(folder)
     with _series_lock:
         snapshots = _series.setdefault(key, [])
         number = len(snapshots)
-        files = (("pores", f"out_{number}.vtu"), ("spheres", f"spheres_{number}.vtu"))
-        write_grid(pore_grid(state, with_boundaries), os.path.join(folder, files[0][1]), compress)
-        write_grid(sphere_grid(state), os.path.join(folder, files[1][1]), compress)
-        snapshots.append(_Snapshot(state.time, files))
+        files = tuple((name, f"{prefix}_{number}.vtu") for name, prefix, _ in grids)
+        for (_, file), (_, _, grid) in zip(files, grids):
+            write_grid(grid, os.path.join(folder, file), compress)
+        snapshots.append(_Snapshot(time, files))
         _write_collection(folder, snapshots)
     return [os.path.join(folder, f) for _, f in files] + [os.path.join(folder, COLLECTION)]
+
+
+def save(state: FlowState, folder: str, with_boundaries: bool, compress: bool) -> list[str]:
+    """Write the snapshot `state` into `folder` as out_<N>.vtu and spheres_<N>.vtu (save_grids)."""
+    grids = [("pores", "out", pore_grid(state, with_boundaries)), ("spheres", "spheres", sphere_grid(state))]
+    return save_grids(folder, state.time, grids, compress)

@@ -97,23 +97,6 @@ _SAVED_CORE_SETTINGS = ("max_k_div_k_mean",) + tuple(
     )
 )
 
-# What YADE saves of a PyRunner besides its command and label: when it runs.
-_RUNNER_SCHEDULE = (
-    "iterPeriod",
-    "virtPeriod",
-    "realPeriod",
-    "nDo",
-    "initRun",
-    "firstIterRun",
-    "iterLast",
-    "virtLast",
-    "realLast",
-    "nDone",
-    "dead",
-    "ignoreErrors",
-    "updateGlobals",
-)
-
 # The engine's own fields (plain instance attributes, not YADE attributes): the core, the engine's
 # key in the registry, its lock, its timings, ompThreads, and its parts.
 _FIELDS = frozenset(
@@ -556,7 +539,7 @@ class FlowEngine(PyRunner):
         engine._threads = state["threads"]
         for key, part in _SAVED_PARTS.items():
             getattr(engine, part).restore(state[key])
-        for name in _RUNNER_SCHEDULE:  # YADE restores them (a script may have changed them since the load)
+        for name in attributes.RUNNER_SCHEDULE:  # YADE restores them (a script may have changed them since the load)
             setattr(engine, name, getattr(runner, name))
         engine.label = runner.label
         if state["run"] is not None:

@@ -19,8 +19,11 @@ from yade.minieigenHP import Vector3
 from yade._packSpheres import SpherePack
 from yade.wrapper import PyRunner, Sphere
 
+from . import _attributes as attributes
+from . import _persistence
 from ._attributes import runner_attributes
 from ._core import PeriodicFlow, YadeForceBridge, gather_sphere_pack, sphere_pack_size
+from ._timing import IdleClock, StageTimings, StepClock
 
 _COMMAND = "__import__('pfv.periodic_flow_engine').periodic_flow_engine._run({})"
 _engines = weakref.WeakValueDictionary()  # key -> engine: the PyRunner commands find their engine here
@@ -45,25 +48,38 @@ _WALLED_ONLY = frozenset(
         "zmax",
         "getBoundaryFlux",
         "setBoundaryNormal",
-        "imposeFluxes",
-        "clearImposedPressure",
-        "clearImposedFlux",
         "bndCondIsTemperature",
         "thermalBndCondValue",
     }
 )
 _FIELDS = frozenset(
-    {"_core", "_key", "_settings", "_spheres", "_bridge", "_pack", "_last_remesh", "_remesh_asked", "_last_step"}
+    {
+        "_core",
+        "_key",
+        "_settings",
+        "_spheres",
+        "_bridge",
+        "_pack",
+        "_last_remesh",
+        "_remesh_asked",
+        "_last_step",
+        "_timings",
+    }
 )
+_IDLE_CLOCK = IdleClock()
 
 
 def _run(key: int) -> None:
     engine = _engines.get(key)
-    if engine is None:
-        raise RuntimeError(
-            "pfv.PeriodicFlowEngine: this engine's state is not in this process (a scene saved with O.save and "
-            "loaded again): saving and loading a periodic engine is not supported yet; add a new engine after O.load"
-        )
+    # After O.load the running PyRunner is YADE's restored copy: the engine rebuilt from the scene's saved state
+    # stands for it (_persistence), not an engine of the same key that may still live in this process.
+    if engine is None or not any(e is engine for e in yade.O.engines):
+        engine = _persistence.engine_for(_COMMAND.format(key))
+        if engine is None:
+            raise RuntimeError(
+                "this pfv.PeriodicFlowEngine must be re-created: YADE restored it as a plain PyRunner and the scene "
+                "carries no saved state for it; create a new pfv.PeriodicFlowEngine and put it back into O.engines"
+            )
     engine._step()
 
 
@@ -111,6 +127,7 @@ class PeriodicFlowEngine(PyRunner):
         self._last_remesh = None
         self._remesh_asked = False
         self._last_step = None  # O.iter of the last step
+        self._timings = StageTimings()
         _engines[self._key] = self
         self.command = _COMMAND.format(self._key)
         self.iterPeriod = 1
@@ -223,6 +240,43 @@ class PeriodicFlowEngine(PyRunner):
             self._remesh_asked = True
             self._core.request_remesh()
 
+    @property
+    def timingDeltas(self) -> StageTimings:
+        """The engine's stages for YADE's timing.stats() while O.timingEnabled."""
+        return self._timings
+
+    # -- point conditions ------------------------------------------------------------------------
+    def imposePressure(self, pos: Any, p: Any) -> int:
+        """Impose pressure p in the pore holding pos (any point, in any period): its p~ is set so that
+        getPorePressure(pos) is p, which fixes the constant of p~ (no reference pore then). Kept through remeshes;
+        returns the condition's index for setImposedPressure."""
+        return self._core.impose_pressure(
+            attributes.as_point("imposePressure position", pos), attributes.as_number("imposePressure pressure", p)
+        )
+
+    def setImposedPressure(self, cond: Any, p: Any) -> None:
+        """Change the pressure of imposed condition number cond (at the next step, without a new factor)."""
+        try:
+            self._core.set_imposed_pressure(
+                attributes.as_index("setImposedPressure cond", cond),
+                attributes.as_number("setImposedPressure pressure", p),
+            )
+        except IndexError as error:
+            raise IndexError(f"pfv.PeriodicFlowEngine.{error}") from None
+
+    def clearImposedPressure(self) -> None:
+        self._core.clear_imposed_pressure()
+
+    def imposeFlux(self, pos: Any, p: Any) -> None:
+        """A flux p through the pore holding pos, YADE's sign: outflow positive, inflow negative. Incompressible and
+        without an imposed pressure, the reference pore takes the net inflow."""
+        self._core.impose_flux(
+            attributes.as_point("imposeFlux position", pos), -attributes.as_number("imposeFlux flux", p)
+        )
+
+    def clearImposedFlux(self) -> None:
+        self._core.clear_imposed_flux()
+
     # -- queries ---------------------------------------------------------------------------------
     def _require_mesh(self) -> None:
         if not self._core.has_mesh():
@@ -249,6 +303,96 @@ class PeriodicFlowEngine(PyRunner):
 
     def nCells(self) -> int:
         return self._core.n_cells
+
+    def getCellPressure(self, id: int) -> float:
+        """The pressure p~ + gradP . x of pore cell `id` (0 <= id < nCells()), x its power centre."""
+        self._require_mesh()
+        n = self._core.n_cells
+        if isinstance(id, bool) or not isinstance(id, (int, np.integer)) or not 0 <= id < n:
+            raise IndexError(f"pfv.PeriodicFlowEngine.getCellPressure: no cell {id!r} (the mesh has {n} cells)")
+        return float(self._core.pressure()[id])
+
+    def averagePressure(self) -> float:
+        """The pores' pressure averaged over one period, weighted by the cells' volumes as YADE's."""
+        self._require_mesh()
+        return float(np.average(self._core.pressure(), weights=self._core.cell_volumes()))
+
+    def average_fluid_pressure(self) -> float:
+        """The pores' pressure averaged over the fluid: weighted by the cells' fluid volumes (what changes by
+        K dV / V_f in an undrained loading)."""
+        self._require_mesh()
+        return float(np.average(self._core.pressure(), weights=self._core.fluid_volumes()))
+
+    def saveVtk(self, folder: Any = "./VTK", withBoundaries: Any = False, compress: Any = False) -> None:
+        """Write one period's pores (pressure, imposed flag, volumes) and the spheres (radii, ids, fluid forces) of
+        the last step into `folder` as VTK XML files for ParaView: out_<N>.vtu, spheres_<N>.vtu and the collection
+        out.pvd, at O.time (doc/periodic.md). withBoundaries is accepted for YADE's scripts: a periodic cell has no
+        boundary cells."""
+        import os
+
+        if not isinstance(folder, (str, os.PathLike)):
+            raise TypeError(f"saveVtk folder must be a path, got {folder!r}")
+        attributes.as_flag("saveVtk withBoundaries", withBoundaries)
+        compress = attributes.as_flag("saveVtk compress", compress)
+        self._require_mesh()
+        try:
+            from . import _periodic_vtk
+        except ImportError as error:
+            raise ImportError(
+                f"pfv.PeriodicFlowEngine.saveVtk needs VTK's Python package (apt-get install python3-vtk9): {error}"
+            ) from None
+        _periodic_vtk.save(_periodic_vtk.read_state(self), os.fspath(folder), compress)
+
+    # -- O.save / O.load (_persistence) -----------------------------------------------------------
+    @staticmethod
+    def drives(command: str) -> bool:
+        """Whether a PyRunner command is that of a pfv.PeriodicFlowEngine (a restored one after a load)."""
+        return command.startswith(_COMMAND.split("{")[0])
+
+    def _saved_state(self) -> dict[str, Any]:
+        """Everything a new engine needs to go on where this one is: settings, conditions and, once it has run,
+        the spheres it ran with and the core's run state."""
+        running = self._core.has_mesh() and self._spheres is not None
+        return {
+            "settings": dict(self._settings),
+            "imposed_pressures": self._core.imposed_pressures(),
+            "imposed_fluxes": self._core.imposed_fluxes(),
+            "ids": self._spheres[0].astype(float) if running else None,
+            "last_remesh": self._last_remesh,
+            "last_step": self._last_step,
+            "remesh_asked": self._remesh_asked,
+            "run": self._core.run_state() if running else None,
+        }
+
+    @classmethod
+    def _from_saved(cls, state: dict[str, Any], runner: PyRunner) -> PeriodicFlowEngine:
+        """A new engine from _saved_state() in the loaded scene, in place of the restored `runner`."""
+        engine = cls()
+        engine._apply_settings(**state["settings"])
+        for pos, p in state["imposed_pressures"]:
+            engine._core.impose_pressure(tuple(pos), p)
+        for pos, q in state["imposed_fluxes"]:
+            engine._core.impose_flux(tuple(pos), q)
+        for name in attributes.RUNNER_SCHEDULE:  # YADE restores them (a script may have changed them since)
+            setattr(engine, name, getattr(runner, name))
+        engine.label = runner.label
+        if state["run"] is not None:
+            engine._resume(state)
+        return engine
+
+    def _resume(self, state: dict[str, Any]) -> None:
+        """Rebuild the saved mesh and step history in the loaded scene, whose spheres must be those saved."""
+        self._scan(yade.O)
+        saved_ids = np.asarray(state["ids"]).astype(np.int64)
+        if not np.array_equal(saved_ids, self._spheres[0]):
+            raise RuntimeError(
+                "pfv.PeriodicFlowEngine: the loaded scene's spheres are not those its engine was saved with"
+            )
+        self._core.resume(state["run"])
+        self._last_remesh, self._last_step = state["last_remesh"], state["last_step"]
+        self._remesh_asked = state["remesh_asked"]
+        if self._remesh_asked:
+            self._core.request_remesh()
 
     # -- the step --------------------------------------------------------------------------------
     def _scan(self, scene: Any) -> None:
@@ -297,6 +441,7 @@ class PeriodicFlowEngine(PyRunner):
 
     def _step(self) -> None:
         scene = yade.O
+        clock = StepClock(self._timings) if scene.timingEnabled else _IDLE_CLOCK
         if not scene.periodic:
             raise RuntimeError(
                 "pfv.PeriodicFlowEngine needs a periodic cell (O.periodic = True); for a box bounded by walls use "
@@ -316,13 +461,17 @@ class PeriodicFlowEngine(PyRunner):
             self._core.request_remesh()
             centres = self._centres(scene)
         h = np.array([[scene.cell.hSize[i, j] for j in range(3)] for i in range(3)])
+        clock.lap("positions")
         count = self._core.remesh_count
         self._core.step(centres, self._spheres[1], h, scene.dt)
-        if self._core.remesh_count != count or self._last_remesh is None:
+        remeshed = self._core.remesh_count != count
+        clock.core_step(self._core, remeshed)
+        if remeshed or self._last_remesh is None:
             self._last_remesh = scene.iter
             self._remesh_asked = False
         self._bridge.apply(scene.forces.addF, self._core.forces())
         self._last_step = scene.iter
+        clock.lap("forces to YADE")
 
 
 # Kept as a PyRunner keeps them, but ompThreads: the periodic engine runs at the caller's thread count, and a setting

@@ -7,6 +7,11 @@
 
 #include "pfv/common/stage_timer.hpp"
 #include "pfv/linalg/cholesky_solver.hpp"
+#include "pfv/linalg/gauss_seidel_solver.hpp"
+#include "pfv/linalg/pcg_solver.hpp"
+#if PFV_WITH_HYPRE
+#include "pfv/linalg/amg_solver.hpp"
+#endif
 #include "pfv/model/conductance.hpp"
 
 namespace pfv {
@@ -36,7 +41,31 @@ void PeriodicFlowSettings::validate() const {
           "permeabilityFactor must be positive and finite");
   require(gradient.allFinite(), "gradP must be finite");
   require(std::isfinite(bulk_modulus) && bulk_modulus >= 0, "fluidBulkModulus must be finite and not negative");
+  require(solver != SolverKind::kAuto, "the periodic engine's solver must be named (no automatic choice)");
+  require(solver != SolverKind::kMultigrid || PFV_WITH_HYPRE,
+          "solver 'multigrid': PFV was built without hypre (PFV_WITH_HYPRE=OFF)");
+  require(std::isfinite(tolerance) && tolerance > 0, "tolerance must be positive and finite");
+  require(std::isfinite(relax) && relax > 0 && relax < 2, "relax must be in (0, 2)");
 }
+
+namespace {
+
+std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::kGaussSeidel:
+      return std::make_unique<GaussSeidelSolver>();
+    case SolverKind::kConjugateGradient:
+      return std::make_unique<PcgSolver>();
+#if PFV_WITH_HYPRE
+    case SolverKind::kMultigrid:
+      return std::make_unique<AmgSolver>();
+#endif
+    default:
+      return std::make_unique<CholeskySolver>();
+  }
+}
+
+}  // namespace
 
 struct PeriodicFlow::Meshed {
   // The input, for run_state().
@@ -65,7 +94,7 @@ PeriodicFlow::~PeriodicFlow() = default;
 void PeriodicFlow::set_settings(const PeriodicFlowSettings& s) {
   s.validate();
   if (s.viscosity != settings_.viscosity || s.permeability_factor != settings_.permeability_factor ||
-      s.bulk_modulus != settings_.bulk_modulus)
+      s.bulk_modulus != settings_.bulk_modulus || s.solver != settings_.solver)
     system_due_ = true;
   if (s.gradient != settings_.gradient) source_due_ = true;
   settings_ = s;
@@ -149,7 +178,11 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
   if (system.n_unknowns() > 0) {  // else every pore is known (the cell is one pore, or all imposed)
     std::vector<double> b = system.gather(per_cell);
     system.add_known(known, b);
-    mesh_->solver->solve(b, x, SolveControl{});
+    SolveControl control;
+    control.tolerance = settings_.tolerance;
+    control.relax = settings_.relax;
+    control.time_step = dt;
+    mesh_->solver->solve(b, x, control);
   }
   periodic_pressure_ = system.scatter(x, known);
   step_times_.solve = seconds_since(t0);
@@ -354,7 +387,7 @@ void PeriodicFlow::build_system(double dt) {
     // the pores' graph crosses through every period.
     SolverOptions options;
     options.factor.ordering = Ordering::kMetis;
-    mesh.solver = std::make_unique<CholeskySolver>();
+    mesh.solver = make_solver(settings_.solver);
     mesh.solver->setup(mesh.system.matrix, options);
   }
   step_times_.factorization = seconds_since(t0);

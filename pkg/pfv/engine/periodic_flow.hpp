@@ -30,8 +30,15 @@ struct PeriodicFlowSettings {
   double permeability_factor = 1.0;
   Vec3 gradient = Vec3::Zero();  // gradP, the imposed macroscopic pressure gradient
   double bulk_modulus = 0.0;     // of the fluid; 0: incompressible
+  // The linear solver (pressure_solver.hpp; kAuto is not a choice here): the Cholesky factor
+  // (METIS ordering), Gauss-Seidel or incomplete-Cholesky CG to `tolerance` (with `relax` for
+  // Gauss-Seidel), or multigrid CG (built with hypre) to the refinement's bound.
+  SolverKind solver = SolverKind::kCholesky;
+  double tolerance = 1e-6;
+  double relax = 1.9;
 
-  // Throws std::invalid_argument naming the setting that is not finite or out of range.
+  // Throws std::invalid_argument naming the setting that is not finite or out of range, or a
+  // solver this build does not have.
   void validate() const;
 };
 

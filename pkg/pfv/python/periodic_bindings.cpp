@@ -4,6 +4,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <string>
+
 #include "pfv/engine/periodic_flow.hpp"
 #include "pfv/python/shared_engine.hpp"
 
@@ -42,6 +44,13 @@ PeriodicFlow::RunState from_dict(const py::dict& d) {
   return s;
 }
 
+SolverKind solver_kind(const std::string& name) {
+  for (SolverKind k :
+       {SolverKind::kCholesky, SolverKind::kGaussSeidel, SolverKind::kConjugateGradient, SolverKind::kMultigrid})
+    if (to_string(k) == name) return k;
+  throw py::value_error("solver must be cholesky, gauss_seidel, conjugate_gradient or multigrid, got '" + name + "'");
+}
+
 }  // namespace
 
 void bind_periodic(py::module_& m) {
@@ -51,15 +60,21 @@ void bind_periodic(py::module_& m) {
       .def(py::init<>())
       .def(
           "set_settings",
-          [](PeriodicFlow& f, double viscosity, double permeability_factor, const Vec3& gradient, double bulk_modulus) {
+          [](PeriodicFlow& f, double viscosity, double permeability_factor, const Vec3& gradient, double bulk_modulus,
+             const std::string& solver, double tolerance, double relax) {
             PeriodicFlowSettings s;
             s.viscosity = viscosity;
             s.permeability_factor = permeability_factor;
             s.gradient = gradient;
             s.bulk_modulus = bulk_modulus;
+            s.solver = solver_kind(solver);
+            s.tolerance = tolerance;
+            s.relax = relax;
             f.set_settings(s);
           },
-          py::arg("viscosity"), py::arg("permeability_factor"), py::arg("gradient"), py::arg("bulk_modulus"))
+          py::arg("viscosity"), py::arg("permeability_factor"), py::arg("gradient"), py::arg("bulk_modulus"),
+          py::arg("solver") = "cholesky", py::arg("tolerance") = 1e-6, py::arg("relax") = 1.9,
+          "solver: cholesky, gauss_seidel, conjugate_gradient or multigrid.")
       .def(
           "step",
           [](PeriodicFlow& f, const Array& centres, const Array& radii, const Array& h, double dt) {

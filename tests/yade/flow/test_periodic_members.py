@@ -8,6 +8,8 @@ A jittered simple cubic array of 4 x 4 x 4 spheres in a periodic cell. Checked:
   pressure where the fluid leaves; clearImposed* undo them;
 * getCellPressure is the pressure at each pore's power centre (p~ + gradP . x); averagePressure weighs them by the
   cells' volumes; bad ids raise;
+* useSolver 0 (Gauss-Seidel), 1 (conjugate gradients) and solver="multigrid" to a tight tolerance give the Cholesky
+  factor's pressures; unknown solvers and a relax outside (0, 2) raise;
 * O.timingEnabled: timing.stats() lists the engine's stages (the stages' times are not checked);
 * saveVtk: the files read back with VTK give one cell per pore, the engine's pressures and volumes; the pores' volumes
   add up to the cell's, and each sphere is written once, inside the cell;
@@ -93,6 +95,32 @@ checks.expect_error("getCellPressure(-1)", IndexError, "getCellPressure", lambda
 checks.expect_error(
     "getCellPressure(nCells)", IndexError, "getCellPressure", lambda: flow.getCellPressure(flow.nCells())
 )
+
+# -- solvers ----------------------------------------------------------------------------------------------------
+# Each solver starts from the pressures of another gradient and must reach the factor's pressures of this one.
+flow.fluidBulkModulus = 0
+flow.gradP = (0.0, 1.0, 3.0)
+O.step()
+direct = core.pressure().copy()
+for code, name in ((0, "gauss_seidel"), (1, "conjugate_gradient"), (None, "multigrid"), (3, "cholesky")):
+    flow.gradP = (2.0, 0.0, 0.0)
+    O.step()
+    if code is None:
+        flow.solver = name
+    else:
+        flow.useSolver = code
+    flow.tolerance = 1e-12
+    flow.gradP = (0.0, 1.0, 3.0)
+    O.step()
+    spread = direct.max() - direct.min()
+    error = np.abs(core.pressure() - direct).max() / spread
+    checks.check(
+        f"{name} (useSolver {flow.useSolver}): the factor's pressures", error < 1e-8, f"{error:.2g} of the spread"
+    )
+checks.expect_error("useSolver = 2", ValueError, "useSolver", lambda: setattr(flow, "useSolver", 2))
+checks.expect_error("solver = 'lu'", ValueError, "solver", lambda: setattr(flow, "solver", "lu"))
+checks.expect_error("relax = 2", ValueError, "relax", lambda: setattr(flow, "relax", 2.0))
+checks.check("the refused settings left the solver as it was", flow.solver == "cholesky" and flow.relax == 1.9)
 
 # -- timing -----------------------------------------------------------------------------------------------------
 O.timingEnabled = True

@@ -67,6 +67,7 @@ _FIELDS = frozenset(
     }
 )
 _IDLE_CLOCK = IdleClock()
+_SOLVER_CODE = {"gauss_seidel": 0, "conjugate_gradient": 1, "cholesky": 3, "multigrid": 3}
 
 
 def _run(key: int) -> None:
@@ -119,7 +120,9 @@ class PeriodicFlowEngine(PyRunner):
             meshUpdateInterval=1000,
             defTolerance=0.05,
             duplicateThreshold=0.06,
-            useSolver=3,
+            solver="cholesky",
+            tolerance=1e-6,
+            relax=1.9,
         )
         self._spheres = None  # (ids, radii, body count) of the last scan
         self._bridge = None
@@ -155,7 +158,15 @@ class PeriodicFlowEngine(PyRunner):
 
     def _apply_settings(self, **changes: Any) -> None:
         s = dict(self._settings, **changes)
-        self._core.set_settings(s["viscosity"], s["permeabilityFactor"], s["gradP"], s["fluidBulkModulus"])
+        self._core.set_settings(
+            s["viscosity"],
+            s["permeabilityFactor"],
+            s["gradP"],
+            s["fluidBulkModulus"],
+            solver=s["solver"],
+            tolerance=s["tolerance"],
+            relax=s["relax"],
+        )
         self._settings = s
 
     @property
@@ -222,13 +233,51 @@ class PeriodicFlowEngine(PyRunner):
 
     @property
     def useSolver(self) -> int:
-        """3 (the direct solve), the only solver of the periodic engine."""
-        return 3
+        """YADE's code of the linear solver: 0 Gauss-Seidel (to `tolerance`, over-relaxed by `relax`), 1
+        incomplete-Cholesky conjugate gradients (a PFV extension, to `tolerance`), 3 the Cholesky factor (the
+        default); 3 also while `solver` is "multigrid"."""
+        return _SOLVER_CODE[self._settings["solver"]]
 
     @useSolver.setter
     def useSolver(self, value: Any) -> None:
-        if value != 3:
-            raise ValueError(f"pfv.PeriodicFlowEngine.useSolver: only 3 (the direct solve) is available, got {value!r}")
+        code = attributes.as_integer("useSolver", value)
+        names = {v: k for k, v in _SOLVER_CODE.items() if k != "multigrid"}
+        if code not in names:
+            raise ValueError(
+                f"pfv.PeriodicFlowEngine.useSolver must be 0 (Gauss-Seidel), 1 (conjugate gradients) or 3 (Cholesky), "
+                f"got {value!r}"
+            )
+        self._apply_settings(solver=names[code])
+
+    @property
+    def solver(self) -> str:
+        """The linear solver by name (a PFV extension): "cholesky", "gauss_seidel", "conjugate_gradient" or
+        "multigrid" (conjugate gradients preconditioned by hypre's BoomerAMG, memory O(N))."""
+        return self._settings["solver"]
+
+    @solver.setter
+    def solver(self, value: Any) -> None:
+        if value not in _SOLVER_CODE:
+            raise ValueError(f"pfv.PeriodicFlowEngine.solver must be one of {sorted(_SOLVER_CODE)}, got {value!r}")
+        self._apply_settings(solver=value)
+
+    @property
+    def tolerance(self) -> float:
+        """The iterative solvers' stopping tolerance (YADE's: Gauss-Seidel's max|dp|/max|p|)."""
+        return self._settings["tolerance"]
+
+    @tolerance.setter
+    def tolerance(self, value: Any) -> None:
+        self._apply_settings(tolerance=_number("tolerance", value, 0.0, strict=True))
+
+    @property
+    def relax(self) -> float:
+        """Gauss-Seidel's over-relaxation, in (0, 2)."""
+        return self._settings["relax"]
+
+    @relax.setter
+    def relax(self, value: Any) -> None:
+        self._apply_settings(relax=_number("relax", value, 0.0, strict=True))
 
     @property
     def updateTriangulation(self) -> bool:

@@ -46,6 +46,26 @@ struct CellKeyHash {
 
 constexpr int kNotKept = -1;
 
+// The grid the triangulation's input is rounded to: a power of two 2^-50 of the largest
+// coordinate an image can have, so that a sphere's wrapped centre plus any lattice translation of
+// the rounded cell is exact in double. Every image of a pore is then the exact translate of the
+// others, and CGAL's symbolic perturbation (which orders points lexicographically, an order
+// translations keep) splits cospherical pores (regular arrays) the same way in every period;
+// rounded translations would split them differently and no consistent triangulation would exist.
+// The rounding moves points by 1e-15 of the cell. (The wrapped centres lie in the cell, and the
+// images within kMaxMarginWidths widths of it.)
+double grid_step(const PeriodicCell& cell) {
+  const double periods = std::ceil(PeriodicTriangulation::kMaxMarginWidths *
+                                   std::max({cell.width(0), cell.width(1), cell.width(2)}) / cell.min_width());
+  const double bound = (periods + 3) * cell.h.cwiseAbs().rowwise().sum().maxCoeff();
+  return std::ldexp(1.0, std::ilogb(bound) + 1 - 50);
+}
+
+template <class M>
+M snap(const M& x, double grid) {
+  return (x / grid).array().round().matrix() * grid;
+}
+
 }  // namespace
 
 struct PeriodicTriangulation::Impl {
@@ -91,21 +111,23 @@ const PeriodicMesh& PeriodicTriangulation::build(const std::vector<Vec3>& centre
   if (!cell.h.allFinite() || !(cell.volume() > 0) || !(cell.min_width() > 0))
     throw std::invalid_argument("periodic triangulation: the cell matrix is degenerate or not finite");
   Impl& m = *impl_;
-  m.cell = cell;
-  m.h_inverse = cell.h.inverse();
+  for (int k = 0; k < n; ++k)
+    if (!centres[k].allFinite() || !(radii[k] > 0) || !std::isfinite(radii[k]))
+      throw std::invalid_argument("periodic triangulation: sphere " + std::to_string(k) +
+                                  " has a non-finite centre or a radius that is not positive");
+  const double grid = grid_step(cell);
+  m.cell = PeriodicCell{snap(cell.h, grid)};
+  m.h_inverse = m.cell.h.inverse();
   m.wrapped.resize(n);
   m.wrap.resize(n);
   m.fractional.resize(n);
   double r_max = 0;
   for (int k = 0; k < n; ++k) {
-    if (!centres[k].allFinite() || !(radii[k] > 0) || !std::isfinite(radii[k]))
-      throw std::invalid_argument("periodic triangulation: sphere " + std::to_string(k) +
-                                  " has a non-finite centre or a radius that is not positive");
     const Vec3 f = m.h_inverse * centres[k];
     for (int a = 0; a < 3; ++a) m.wrap[k][a] = -static_cast<int>(std::floor(f[a]));
     // The wrapped centre is the centre moved by whole periods (not h times the fractional
     // part): the same translation at every step, so the images follow the spheres exactly.
-    m.wrapped[k] = centres[k] + cell.translation(m.wrap[k]);
+    m.wrapped[k] = snap(Vec3(centres[k] + cell.translation(m.wrap[k])), grid);
     m.fractional[k] = m.h_inverse * m.wrapped[k];
     r_max = std::max(r_max, radii[k]);
   }

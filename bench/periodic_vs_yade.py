@@ -6,11 +6,12 @@ Scene: a simple cubic array of side^3 spheres (radius 0.4995, spacing 1, centres
 5: YADE's engine gives NaN on the exact, cospherical array) in a periodic cell of side `side`, gradP = (0, 1, 0),
 viscosity 1, the spheres fixed (a static skeleton: both engines keep their mesh), O.dt = 1e-5, one thread.
 
-Per side, both engines in one process. A fresh engine of each kind takes the scene in turn for its first step (the
-wall time of that O.step() minus the median dry step: triangulation, system, factorisation, first solve and
-forces). Then `rounds` rounds, each running 3 dry steps (no flow engine), 3 steps with YADE's engine and 3 with
-PFV's, the order of the two engines alternating; the flow step of an engine is the median over the rounds of its
-block's median minus the dry block's median. Printed: the times, their ratio PFV / YADE, and both engines'
+Per side, both engines in one process. In each of `rounds` rounds a fresh engine of each kind takes the scene in
+turn for its first step (the wall time of that O.step() minus the median of 3 dry steps: triangulation, system,
+factorisation, first solve and forces), the order of the two engines alternating; the first step is the median over
+the rounds. Then `rounds` rounds, each running 3 dry steps (no flow engine), 3 steps with YADE's engine and 3 with
+PFV's, alternating again; the flow step of an engine is the median over the rounds of its block's median minus the
+dry block's median. Printed: the times, their ratio PFV / YADE, and both engines'
 permeability (-averageVelocity_y). No time is asserted anywhere.
 """
 import statistics
@@ -59,22 +60,29 @@ def block():
     return statistics.median(yade_step() for _ in range(3))
 
 
+def order(r):
+    return ("yade", "pfv") if r % 2 == 0 else ("pfv", "yade")
+
+
 def measure(side, rounds):
     build(side)
-    dry = block()
-    engines, first = {}, {}
-    for kind in ("yade", "pfv"):
-        engines[kind] = make(kind)
-        first[kind] = with_flow(engines[kind], yade_step) - dry
+    engines, first = {}, {"yade": [], "pfv": []}
+    for r in range(rounds):
+        dry = block()
+        for kind in order(r):
+            engines[kind] = make(kind)
+            first[kind].append(with_flow(engines[kind], yade_step) - dry)
     coupled = {"yade": [], "pfv": []}
     for r in range(rounds):
         dry = block()
-        for kind in ("yade", "pfv") if r % 2 == 0 else ("pfv", "yade"):
+        for kind in order(r):
             coupled[kind].append(with_flow(engines[kind], block) - dry)
     out = {}
     for kind, flow in engines.items():
         out[kind] = dict(
-            first=first[kind], step=statistics.median(coupled[kind]), kappa=-float(flow.averageVelocity()[1])
+            first=statistics.median(first[kind]),
+            step=statistics.median(coupled[kind]),
+            kappa=-float(flow.averageVelocity()[1]),
         )
     return out
 

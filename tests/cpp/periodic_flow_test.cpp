@@ -164,3 +164,28 @@ TEST(PeriodicFlow, RefusesBadInputAndChangesNothing) {
   EXPECT_EQ(flow.remesh_count(), 1);
   EXPECT_EQ(flow.periodic_pressure(), kept);
 }
+
+TEST(PeriodicFlow, DefToleranceRemeshesOnceThePoresHaveStrainedEnough) {
+  // The cell and its spheres shrink by 1e-4 per step: every pore's volume by 1 - (1 - 1e-4)^3 =
+  // 3.0e-4 per step. With YADE's defTolerance 1e-3 the strain passes it on the fourth step after
+  // the mesh, and the fifth remeshes; without it the mesh stays.
+  const auto p = random_periodic(80, 43, diagonal(1, 1, 1), 0.05, 0.08);
+  for (const double tolerance : {1e-3, 0.0}) {
+    PeriodicFlowSettings s = settings(0.0);
+    s.def_tolerance = tolerance;
+    PeriodicFlow flow;
+    flow.set_settings(s);
+    Eigen::Matrix3d h = p.cell.h;
+    flow.step(p.centre, p.radius, h, 1e-4);
+    for (int step = 1; step <= 5; ++step) {
+      const Eigen::Matrix3d next = h * (1 - 1e-4);
+      const auto x = deformed(p.centre, p.cell.h, next);
+      h = next;
+      flow.step(x, p.radius, h, 1e-4);
+      const int expected = tolerance > 0 && step == 5 ? 2 : 1;
+      EXPECT_EQ(flow.remesh_count(), expected) << "tolerance " << tolerance << ", step " << step;
+      // each step dV / V = (1 - 1e-4)^-3 - 1, V the step's new volume
+      if (step == 4) EXPECT_NEAR(flow.strain(), 4 * (std::pow(1 - 1e-4, -3) - 1), 1e-9);
+    }
+  }
+}

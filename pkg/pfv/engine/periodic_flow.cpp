@@ -46,6 +46,7 @@ void PeriodicFlowSettings::validate() const {
           "solver 'multigrid': PFV was built without hypre (PFV_WITH_HYPRE=OFF)");
   require(std::isfinite(tolerance) && tolerance > 0, "tolerance must be positive and finite");
   require(std::isfinite(relax) && relax > 0 && relax < 2, "relax must be in (0, 2)");
+  require(std::isfinite(def_tolerance) && def_tolerance >= 0, "defTolerance must be finite and not negative");
 }
 
 namespace {
@@ -78,6 +79,7 @@ struct PeriodicFlow::Meshed {
   std::vector<double> conductance;
   std::vector<double> gradient_source;  // s of the imposed gradient: per system and gradient, not per step
   std::vector<double> orientation;      // per cell, the sign of its volume when meshed
+  double mean_cell_volume = 0;
   PeriodicPressureSystem system;
   ForceCache cache;
   PeriodicForces forces;
@@ -160,9 +162,15 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
   image_positions(centres, h, images_);
   volume_rate_.assign(nc, 0.0);
   std::vector<double> volume(nc);
+  // The pores' strain of the step as the walled engine measures it: a sliver's volume counts as the
+  // mean, so that its small motions are not large strains.
+  double max_change = 0;
   for (int c = 0; c < nc; ++c) {
     volume[c] = mesh_->orientation[c] * tetrahedron_volume(m.mesh.cell_vertices[c], images_);
-    if (has_previous_) volume_rate_[c] = (volume[c] - volume_[c]) / dt;
+    if (!has_previous_) continue;
+    const double dv = volume[c] - volume_[c];
+    volume_rate_[c] = dv / dt;
+    max_change = std::max(max_change, std::abs(dv) / std::max(volume[c], mesh_->mean_cell_volume));
   }
   step_times_.volumes = seconds_since(t0);
   t0 = StageClock::now();
@@ -193,6 +201,8 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
   centres_ = centres;
   h_ = h;
   has_previous_ = true;
+  strain_ += max_change;
+  if (settings_.def_tolerance > 0 && strain_ > settings_.def_tolerance) remesh_due_ = true;
   step_times_.total = seconds_since(start);
 }
 
@@ -226,6 +236,7 @@ std::unique_ptr<PeriodicFlow::Meshed> PeriodicFlow::build_mesh(const std::vector
   next->orientation.resize(m.n_cells());
   for (int c = 0; c < m.n_cells(); ++c)
     next->orientation[c] = tetrahedron_volume(m.mesh.cell_vertices[c], m.image_centre) < 0 ? -1.0 : 1.0;
+  next->mean_cell_volume = m.cell.volume() / m.n_cells();
   remesh_times_.geometry = seconds_since(t0);
   t0 = StageClock::now();
   next->cache.build(m.mesh, next->facets, packing);
@@ -257,6 +268,7 @@ void PeriodicFlow::remesh(const std::vector<Vec3>& centres, const std::vector<do
   if (previous) measure_previous_volumes();
   remesh_due_ = false;
   system_due_ = true;
+  strain_ = 0;
   ++remeshes_;
 }
 
@@ -280,6 +292,7 @@ PeriodicFlow::RunState PeriodicFlow::run_state() const {
     state.previous_h = h_;
   }
   state.periodic_pressure = periodic_pressure_;
+  state.strain = strain_;
   return state;
 }
 
@@ -298,6 +311,7 @@ void PeriodicFlow::resume(const RunState& state) {
           "the run state's " + std::to_string(state.periodic_pressure.size()) + " pressures do not match the " +
               std::to_string(next->periodic().n_cells()) + " cells of its rebuilt mesh");
   for (double p : state.periodic_pressure) require(std::isfinite(p), "the run state has a non-finite pressure");
+  require(std::isfinite(state.strain) && state.strain >= 0, "the run state's strain must be finite and not negative");
   mesh_ = std::move(next);
   periodic_pressure_ = state.periodic_pressure;
   has_previous_ = previous;
@@ -308,6 +322,7 @@ void PeriodicFlow::resume(const RunState& state) {
   }
   remesh_due_ = false;
   system_due_ = true;
+  strain_ = state.strain;
   ++remeshes_;
 }
 

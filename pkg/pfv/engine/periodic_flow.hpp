@@ -36,6 +36,9 @@ struct PeriodicFlowSettings {
   SolverKind solver = SolverKind::kCholesky;
   double tolerance = 1e-6;
   double relax = 1.9;
+  // YADE's defTolerance: a remesh once the pores' strain summed over the steps since the last
+  // (each step's largest |dV| / V of a cell, thesis 5.13) exceeds it; 0: off.
+  double def_tolerance = 0.0;
 
   // Throws std::invalid_argument naming the setting that is not finite or out of range, or a
   // solver this build does not have.
@@ -105,6 +108,8 @@ class PeriodicFlow {
   // The pressure p~ + gradP . x at x (anywhere), or NaN before the first step.
   double pressure_at(const Vec3& x) const;
   int remesh_count() const { return remeshes_; }
+  // The pores' strain summed since the last remesh (def_tolerance).
+  double strain() const { return strain_; }
   // Seconds per stage of the last remesh (triangulation, geometry, force_cache, conductance,
   // assembly, factorization: ordering included) and of the last step (volumes, solve, forces,
   // total: the remesh included if the step made one).
@@ -122,6 +127,7 @@ class PeriodicFlow {
     std::vector<Vec3> previous_centres;  // empty: no dV/dt history
     Eigen::Matrix3d previous_h = Eigen::Matrix3d::Identity();
     std::vector<double> periodic_pressure;  // per cell of the mesh
+    double strain = 0;                      // the pores' strain since the mesh was made
   };
   RunState run_state() const;  // needs a mesh
   // Throws std::invalid_argument for a state whose input a step would refuse, or whose pressures
@@ -149,7 +155,7 @@ class PeriodicFlow {
   PeriodicFlowSettings settings_;
   std::unique_ptr<Meshed> mesh_;
   bool remesh_due_ = true, system_due_ = true, source_due_ = true, has_previous_ = false;
-  double system_dt_ = 0;
+  double system_dt_ = 0, strain_ = 0, mean_cell_volume_ = 0;
   int remeshes_ = 0;
   Eigen::Matrix3d h_ = Eigen::Matrix3d::Identity();
   std::vector<Vec3> centres_, images_;  // the last step's

@@ -29,6 +29,7 @@ py::dict to_dict(const PeriodicFlow::RunState& s) {
   d["previous_centres"] = points_to_array(s.previous_centres);
   d["previous_h"] = s.previous_h;
   d["periodic_pressure"] = vector_to_array(s.periodic_pressure);
+  d["strain"] = s.strain;
   return d;
 }
 
@@ -41,6 +42,7 @@ PeriodicFlow::RunState from_dict(const py::dict& d) {
   if (previous.size() > 0) s.previous_centres = to_points(previous, "previous_centres");
   s.previous_h = to_cell(d["previous_h"].cast<Array>());
   s.periodic_pressure = to_vector(d["periodic_pressure"].cast<Array>(), "periodic_pressure");
+  s.strain = d["strain"].cast<double>();
   return s;
 }
 
@@ -61,7 +63,7 @@ void bind_periodic(py::module_& m) {
       .def(
           "set_settings",
           [](PeriodicFlow& f, double viscosity, double permeability_factor, const Vec3& gradient, double bulk_modulus,
-             const std::string& solver, double tolerance, double relax) {
+             const std::string& solver, double tolerance, double relax, double def_tolerance) {
             PeriodicFlowSettings s;
             s.viscosity = viscosity;
             s.permeability_factor = permeability_factor;
@@ -70,11 +72,12 @@ void bind_periodic(py::module_& m) {
             s.solver = solver_kind(solver);
             s.tolerance = tolerance;
             s.relax = relax;
+            s.def_tolerance = def_tolerance;
             f.set_settings(s);
           },
           py::arg("viscosity"), py::arg("permeability_factor"), py::arg("gradient"), py::arg("bulk_modulus"),
           py::arg("solver") = "cholesky", py::arg("tolerance") = 1e-6, py::arg("relax") = 1.9,
-          "solver: cholesky, gauss_seidel, conjugate_gradient or multigrid.")
+          py::arg("def_tolerance") = 0.0, "solver: cholesky, gauss_seidel, conjugate_gradient or multigrid.")
       .def(
           "step",
           [](PeriodicFlow& f, const Array& centres, const Array& radii, const Array& h, double dt) {
@@ -106,6 +109,7 @@ void bind_periodic(py::module_& m) {
       .def("forget_motion", &PeriodicFlow::forget_motion)
       .def("has_mesh", &PeriodicFlow::has_mesh)
       .def_property_readonly("remesh_count", &PeriodicFlow::remesh_count)
+      .def_property_readonly("strain", &PeriodicFlow::strain)
       .def_property_readonly("n_cells", [](const PeriodicFlow& f) { return f.has_mesh() ? f.mesh().n_cells() : 0; })
       .def("periodic_pressure", [](const PeriodicFlow& f) { return vector_to_array(f.periodic_pressure()); })
       .def("pressure", [](const PeriodicFlow& f) { return vector_to_array(f.pressure()); })

@@ -118,7 +118,7 @@ class PeriodicFlowEngine(PyRunner):
             permeabilityFactor=1.0,
             fluidBulkModulus=0.0,
             meshUpdateInterval=1000,
-            defTolerance=0.05,
+            defTolerance=0.0,
             duplicateThreshold=0.06,
             solver="cholesky",
             tolerance=1e-6,
@@ -166,6 +166,7 @@ class PeriodicFlowEngine(PyRunner):
             solver=s["solver"],
             tolerance=s["tolerance"],
             relax=s["relax"],
+            def_tolerance=s["defTolerance"],
         )
         self._settings = s
 
@@ -214,12 +215,13 @@ class PeriodicFlowEngine(PyRunner):
 
     @property
     def defTolerance(self) -> float:
-        """Accepted for YADE's scripts; the periodic engine remeshes every meshUpdateInterval iterations."""
+        """YADE's: a remesh once the pores' strain summed over the steps since the last (each step's largest
+        relative volume change of a pore) exceeds it; 0 (YADE's default): by meshUpdateInterval only."""
         return self._settings["defTolerance"]
 
     @defTolerance.setter
     def defTolerance(self, value: Any) -> None:
-        self._settings["defTolerance"] = _number("defTolerance", value, 0.0, strict=False)
+        self._apply_settings(defTolerance=_number("defTolerance", value, 0.0, strict=False))
 
     @property
     def duplicateThreshold(self) -> float:

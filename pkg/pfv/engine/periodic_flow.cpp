@@ -259,6 +259,22 @@ void PeriodicFlow::remesh(const std::vector<Vec3>& centres, const std::vector<do
       carried[c] = pressure_at(x) - settings_.gradient.dot(x);
       if (!std::isfinite(carried[c])) carried[c] = 0.0;
     }
+  // A compressible fluid stores V_f p~ / K in its pores (the storage acts on p~): the carried
+  // field is shifted so that the fluid-volume-weighted mean of p~, the closed cell's K dV / V_f,
+  // goes on unchanged (carried by position alone it drifts a little at every remesh).
+  if (mesh_ && settings_.bulk_modulus > 0 && !periodic_pressure_.empty()) {
+    const auto weighted_mean = [](const std::vector<double>& volume, const std::vector<double>& p) {
+      double sum = 0, total = 0;
+      for (std::size_t c = 0; c < p.size(); ++c) {
+        sum += volume[c] * p[c];
+        total += volume[c];
+      }
+      return total > 0 ? sum / total : 0.0;
+    };
+    const double shift =
+        weighted_mean(mesh_->cells.fluid_volume, periodic_pressure_) - weighted_mean(next->cells.fluid_volume, carried);
+    for (double& p : carried) p += shift;
+  }
   remesh_times_.carry_over = seconds_since(t0);
   const bool previous = has_previous_ && mesh_ && centres_.size() == centres.size();
   mesh_ = std::move(next);

@@ -185,7 +185,9 @@ TEST(PeriodicFlow, DefToleranceRemeshesOnceThePoresHaveStrainedEnough) {
       const int expected = tolerance > 0 && step == 5 ? 2 : 1;
       EXPECT_EQ(flow.remesh_count(), expected) << "tolerance " << tolerance << ", step " << step;
       // each step dV / V = (1 - 1e-4)^-3 - 1, V the step's new volume
-      if (step == 4) EXPECT_NEAR(flow.strain(), 4 * (std::pow(1 - 1e-4, -3) - 1), 1e-9);
+      if (step == 4) {
+        EXPECT_NEAR(flow.strain(), 4 * (std::pow(1 - 1e-4, -3) - 1), 1e-9);
+      }
     }
   }
 }

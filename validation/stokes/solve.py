@@ -139,9 +139,16 @@ def boundary_conditions(W, V, facets, n_spheres, lateral):
 
 
 def solid_forces(mesh, facets, n_spheres, uh, ph, mu):
-    """The force of the fluid on every sphere and lateral face, -sigma.n with n the outward normal
-    of the fluid, split into its pressure and viscous parts. One marker at a time is tagged 1 in
-    its own MeshTags, so the forms compile once."""
+    """The force of the fluid on every sphere and lateral face (marker_forces)."""
+    named = [(SPHERE_TAG + k, "sphere%d" % k) for k in range(n_spheres)] + [(m, FACES[m - 1]) for m in LATERAL]
+    return marker_forces(mesh, facets, named, uh, ph, mu)
+
+
+def marker_forces(mesh, facets, named, uh, ph, mu):
+    """{name: {"pressure": [x, y, z], "viscous": [x, y, z]}}, for every (marker, name) of `named`, the force
+    of the fluid on the surface of that marker, -sigma.n with n the outward normal of the fluid, split into
+    its pressure and viscous parts. One marker at a time is tagged 1 in its own MeshTags, so the forms
+    compile once."""
     fdim = mesh.topology.dim - 1
     n = ufl.FacetNormal(mesh)
     e = fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
@@ -153,9 +160,7 @@ def solid_forces(mesh, facets, n_spheres, uh, ph, mu):
         )
 
     forces = {}
-    for marker, name in [(SPHERE_TAG + k, "sphere%d" % k) for k in range(n_spheres)] + [
-        (m, FACES[m - 1]) for m in LATERAL
-    ]:
+    for marker, name in named:
         tags = meshtags(
             mesh, fdim, np.sort(facets.find(marker)).astype(np.int32), np.ones(len(facets.find(marker)), dtype=np.int32)
         )
@@ -193,9 +198,19 @@ def direct_solver(A, blr_tolerance, symmetric):
 
 def minres_solver(W, A, bcs, mu, u, v, p, q, rtol):
     """MINRES on the Stokes matrix A with the block-diagonal preconditioner of the module docstring."""
-    a_p = (mu * ufl.inner(ufl.grad(u), ufl.grad(v)) + (1.0 / mu) * p * q) * ufl.dx
-    P = fem.petsc.assemble_matrix(fem.form(a_p), bcs=bcs)
+    P = fem.petsc.assemble_matrix(fem.form(preconditioner_form(mu, u, v, p, q)), bcs=bcs)
     P.assemble()
+    return minres_ksp(W, A, P, rtol), P
+
+
+def preconditioner_form(mu, u, v, p, q):
+    """The bilinear form of the preconditioner's matrix: the vector Laplacian and the pressure mass / mu."""
+    return (mu * ufl.inner(ufl.grad(u), ufl.grad(v)) + (1.0 / mu) * p * q) * ufl.dx
+
+
+def minres_ksp(W, A, P, rtol):
+    """MINRES on A, preconditioned by one BoomerAMG V-cycle on P's velocity block and Jacobi on its pressure
+    block (W the mixed space whose sub-spaces give the blocks' dofs)."""
     _, u_dofs = W.sub(0).collapse()
     _, p_dofs = W.sub(1).collapse()
     is_u = PETSc.IS().createGeneral(np.sort(np.asarray(u_dofs, dtype=np.int32)), comm=MPI.COMM_SELF)
@@ -234,4 +249,4 @@ def minres_solver(W, A, bcs, mu, u, v, p, q, rtol):
         opts.delValue(prefix + key)
     for index_set in (is_u, is_p):
         index_set.destroy()
-    return ksp, P
+    return ksp

@@ -86,6 +86,7 @@ struct PeriodicFlow::Meshed {
   std::unique_ptr<PressureSolver> solver;
   // Per point condition, the cell holding its point (located when the system is built).
   std::vector<int> pressure_cell, flux_cell;
+  std::vector<Vec3> pressure_centre;  // the power centre of the imposed pore's translate holding the point
 
   const PeriodicMesh& periodic() const { return triangulation.mesh(); }
 };
@@ -211,7 +212,7 @@ std::vector<double> PeriodicFlow::known_pressures() const {
   std::vector<double> pore_value(mesh_->periodic().n_cells(), 0.0);
   for (std::size_t i = 0; i < imposed_pressure_.size(); ++i)
     pore_value[system.pore[mesh_->pressure_cell[i]]] =
-        imposed_pressure_[i].value - settings_.gradient.dot(imposed_pressure_[i].position);
+        imposed_pressure_[i].value - settings_.gradient.dot(mesh_->pressure_centre[i]);
   std::vector<double> known(system.pore.size());
   for (std::size_t c = 0; c < known.size(); ++c) known[c] = pore_value[system.pore[c]];
   return known;
@@ -397,15 +398,19 @@ void PeriodicFlow::build_system(double dt) {
     for (std::size_t c = 0; c < storage_.size(); ++c)
       storage_[c] = mesh.cells.fluid_volume[c] / (settings_.bulk_modulus * dt);
   }
-  const auto locate = [&](const std::vector<PointCondition>& points, std::vector<int>& cell) {
+  const auto locate = [&](const std::vector<PointCondition>& points, std::vector<int>& cell,
+                          std::vector<Vec3>* centre) {
     cell.resize(points.size());
+    if (centre) centre->resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) {
-      cell[i] = mesh.triangulation.locate(points[i].position).cell;
-      if (cell[i] < 0) throw std::logic_error("PeriodicFlow: a condition's point is in no cell of the mesh");
+      const auto where = mesh.triangulation.locate(points[i].position);
+      if (where.cell < 0) throw std::logic_error("PeriodicFlow: a condition's point is in no cell of the mesh");
+      cell[i] = where.cell;
+      if (centre) (*centre)[i] = located_centre(where);
     }
   };
-  locate(imposed_pressure_, mesh.pressure_cell);
-  locate(imposed_flux_, mesh.flux_cell);
+  locate(imposed_pressure_, mesh.pressure_cell, &mesh.pressure_centre);
+  locate(imposed_flux_, mesh.flux_cell, nullptr);
   step_times_.conductance = seconds_since(t0);
   t0 = StageClock::now();
   mesh.system =
@@ -445,7 +450,11 @@ double PeriodicFlow::pressure_at(const Vec3& x) const {
   if (!mesh_ || periodic_pressure_.empty()) return std::numeric_limits<double>::quiet_NaN();
   const auto where = mesh_->triangulation.locate(x);
   if (where.cell < 0) return std::numeric_limits<double>::quiet_NaN();
-  return periodic_pressure_[where.cell] + settings_.gradient.dot(x);
+  return periodic_pressure_[where.cell] + settings_.gradient.dot(located_centre(where));
+}
+
+Vec3 PeriodicFlow::located_centre(const PeriodicTriangulation::Location& where) const {
+  return mesh_->cells.power_centre[where.cell] + mesh_->periodic().cell.translation(where.shift);
 }
 
 const CellGeometry& PeriodicFlow::cells() const {

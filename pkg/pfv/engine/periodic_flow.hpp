@@ -63,7 +63,7 @@ class PeriodicFlow {
 
   // Point conditions (YADE's imposePressure, imposeFlux), kept through remeshes: each acts on
   // the pore holding its point, located at the remesh (any point, in any period). An imposed
-  // pressure p sets the pore's p~ to p - gradP . pos, so that pressure_at(pos) is p; it fixes
+  // pressure p sets the pore's p~ so that pressure_at(pos) is p; it fixes
   // the constant of p~ in place of the reference pore. Of two in one pore the later one holds.
   // A flux adds an inflow (volume per time) to its pore; incompressible and with no imposed
   // pressure, the reference pore takes the net inflow. Adding or clearing takes effect at the
@@ -105,7 +105,9 @@ class PeriodicFlow {
   const std::vector<double>& current_volumes() const { return volume_; }
   // The superficial velocity (1/V) sum_f q_f d_f.
   Vec3 mean_velocity() const;
-  // The pressure p~ + gradP . x at x (anywhere), or NaN before the first step.
+  // The pressure of the pore holding x (anywhere, in any period): p~ + gradP . P, P the power
+  // centre of that pore's translate (a cell's pressure, as YADE's getPorePressure); NaN before
+  // the first step.
   double pressure_at(const Vec3& x) const;
   int remesh_count() const { return remeshes_; }
   // The pores' strain summed since the last remesh (def_tolerance).
@@ -150,6 +152,8 @@ class PeriodicFlow {
   void measure_previous_volumes();
   // Per cell, the known p~ of the reference pore (0) and of the imposed pores; the rest 0.
   std::vector<double> known_pressures() const;
+  // The power centre of the located cell's translate that holds the point.
+  Vec3 located_centre(const PeriodicTriangulation::Location& where) const;
   void image_positions(const std::vector<Vec3>& centres, const Eigen::Matrix3d& h, std::vector<Vec3>& out) const;
 
   PeriodicFlowSettings settings_;

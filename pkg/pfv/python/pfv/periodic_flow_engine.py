@@ -334,7 +334,8 @@ class PeriodicFlowEngine(PyRunner):
             raise RuntimeError("pfv.PeriodicFlowEngine has not run yet: no pore mesh (run at least one step)")
 
     def getPorePressure(self, pos: Any) -> float:
-        """The pressure p~ + gradP . x at pos (any point: the periodic part is read in the cell)."""
+        """The pressure of the pore holding pos (any point, in any period): p~ + gradP . x at the power centre x of
+        that pore's translate, as YADE's gives a cell's pressure."""
         self._require_mesh()
         return self._core.pressure_at(_finite_vector("getPorePressure position", pos))
 

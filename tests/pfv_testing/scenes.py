@@ -142,6 +142,12 @@ def build_permeameter(num=1000, seed=1, box=(1.0, 1.0, 1.0), frozen=True, reset=
     a flow engine is to be inserted before NewtonIntegrator by the caller (see insert_flow).
     Returns dict(walls=[0..5], spheres=[ids], digest=str, box=box)."""
     spheres = packing(num, seed, box)
+    return dict(build_box(spheres, box, frozen, reset), digest=packing_digest(spheres))
+
+
+def build_box(spheres, box, frozen=True, reset=True):
+    """The permeameter of build_permeameter with the spheres [(x, y, z, r), ...] in the box [0, box]: walls 0..5,
+    then the spheres, the DEM engines and O.dt. Returns dict(walls=[0..5], spheres=[ids], box=box)."""
     if reset:
         O.reset()
     O.materials.append(FrictMat(young=1e6, poisson=0.5, frictionAngle=math.radians(30), density=2600, label='spheres'))
@@ -165,7 +171,7 @@ def build_permeameter(num=1000, seed=1, box=(1.0, 1.0, 1.0), frozen=True, reset=
         NewtonIntegrator(damping=0, label='newton'),
     ]
     O.dt = 1e-5
-    return dict(walls=walls, spheres=ids, digest=packing_digest(spheres), box=tuple(box))
+    return dict(walls=walls, spheres=ids, box=tuple(box))
 
 
 def insert_flow(flow):

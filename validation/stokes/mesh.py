@@ -90,22 +90,8 @@ def build(packing, surface, layer=0.32, order=2, verbose=False):
         smallest = field.add("Min")
         field.setNumbers(smallest, "FieldsList", fields)
         field.setAsBackgroundMesh(smallest)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay: deterministic
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.mesh.generate(3)
-        if order > 1:
-            gmsh.model.mesh.setOrder(order)
-            # Curving the edges onto the spheres tangles cells whose straight edges cut a narrow gap:
-            # their Jacobian changes sign inside the cell (1-2 % of the cells at these sizes), which
-            # breaks the flux balance between the two pressure faces (3e-3 on the 8-sphere packing,
-            # 3e-2 on 54 spheres) and moves the pressure / viscous split of single sphere forces by
-            # tens of per cent on coarse meshes. gmsh's elastic untangling leaves under 0.1 % of the
-            # cells folded on 8 to 54 spheres.
-            gmsh.model.mesh.optimize("HighOrderElastic")
-        mesh, cells, facets = gmshio.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=3)
+        mesh_options()
+        mesh, cells, facets = generate(order)
     finally:
         gmsh.finalize()
     return mesh, cells, facets
@@ -120,3 +106,27 @@ def tangled_cells(mesh):
     n = mesh.topology.index_map(mesh.topology.dim).size_local
     values = det.eval(np.arange(n, dtype=np.int32)).reshape(n, -1)
     return int(np.count_nonzero(values.min(axis=1) * values.max(axis=1) <= 0))
+
+
+def mesh_options():
+    """gmsh's options of every mesh here: sizes from the background field alone, deterministic, one thread."""
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay: deterministic
+    gmsh.option.setNumber("General.NumThreads", 1)
+
+
+def generate(order):
+    """The 3-D mesh of gmsh's current model, of the given order, as dolfinx's (mesh, cell tags, facet tags)."""
+    gmsh.model.mesh.generate(3)
+    if order > 1:
+        gmsh.model.mesh.setOrder(order)
+        # Curving the edges onto the spheres tangles cells whose straight edges cut a narrow gap:
+        # their Jacobian changes sign inside the cell (1-2 % of the cells at these sizes), which
+        # breaks the flux balance between the two pressure faces (3e-3 on the 8-sphere packing,
+        # 3e-2 on 54 spheres) and moves the pressure / viscous split of single sphere forces by
+        # tens of per cent on coarse meshes. gmsh's elastic untangling leaves under 0.1 % of the
+        # cells folded on 8 to 54 spheres.
+        gmsh.model.mesh.optimize("HighOrderElastic")
+    return gmshio.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=3)

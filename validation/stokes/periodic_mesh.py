@@ -15,10 +15,8 @@ import itertools
 
 import gmsh
 import numpy as np
-from dolfinx.io import gmshio
-from mpi4py import MPI
 
-from .mesh import BULK_PER_SURFACE, SPHERE_TAG
+from .mesh import BULK_PER_SURFACE, SPHERE_TAG, generate, mesh_options
 
 # A sphere nearer to tangency with a face plane than this (relative to the cell) is refused: it would cut the
 # face in a vanishing circle or leave a gap far thinner than any element size this module makes.
@@ -121,14 +119,6 @@ def _size_field(spheres, surface, layer):
     field.setAsBackgroundMesh(smallest)
 
 
-def _mesh_options():
-    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-    gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay: deterministic
-    gmsh.option.setNumber("General.NumThreads", 1)
-
-
 def build(packing, surface, layer=0.32, order=2, verbose=False):
     """The dolfinx mesh, cell tags and facet tags of the fluid in the periodic cell of `packing` (its
     ``cell``, the side lengths, default the unit cube; ``centres`` inside the cell; ``radii``)."""
@@ -153,13 +143,8 @@ def build(packing, surface, layer=0.32, order=2, verbose=False):
             gmsh.model.addPhysicalGroup(2, tags, marker)
         _make_periodic(groups, cell)
         _size_field(near, surface, layer)
-        _mesh_options()
-        gmsh.model.mesh.generate(3)
-        if order > 1:
-            gmsh.model.mesh.setOrder(order)
-            # mesh.py's reason: curving the edges onto the spheres folds cells across narrow gaps.
-            gmsh.model.mesh.optimize("HighOrderElastic")
-        mesh, cells, facets = gmshio.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=3)
+        mesh_options()
+        mesh, cells, facets = generate(order)
     finally:
         gmsh.finalize()
     return mesh, cells, facets

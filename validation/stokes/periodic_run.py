@@ -43,7 +43,7 @@ import numpy as np
 
 from . import mesh as walled_mesh
 from . import periodic_mesh, periodic_solve
-from .report import MIN_SHRINK_ORDER, richardson
+from .report import MIN_SHRINK_ORDER, check_stored, richardson
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -366,20 +366,7 @@ def compare_quick(now, ref):
 
 
 def quick(write_reference):
-    now = quick_numbers()
-    if write_reference:
-        with open(QUICK_REFERENCE, "w") as f:
-            json.dump(now, f, indent=1)
-        print("wrote", QUICK_REFERENCE)
-        return 0
-    with open(QUICK_REFERENCE) as f:
-        ref = json.load(f)
-    rows = compare_quick(now, ref)
-    for what, value, expected, ok in rows:
-        print("%-45s %14.8g %14.8g  %s" % (what, value, expected, "ok" if ok else "FAIL"))
-    failed = sum(1 for r in rows if not r[3])
-    print("%d passed, %d failed" % (len(rows) - failed, failed))
-    return 1 if failed else 0
+    return check_stored(quick_numbers(), QUICK_REFERENCE, compare_quick, write_reference)
 
 
 def main():

@@ -538,3 +538,21 @@ def main():
 
 if __name__ == "__main__":
     main()
+
+
+def check_stored(numbers, path, compare, write_reference):
+    """A quick run's `numbers` against those stored in `path` (or stored there with `write_reference`): prints
+    compare(numbers, stored)'s rows (what, value, expected, ok) and returns the exit status, 1 if any failed."""
+    if write_reference:
+        with open(path, "w") as f:
+            json.dump(numbers, f, indent=1)
+        print("wrote", path)
+        return 0
+    with open(path) as f:
+        stored = json.load(f)
+    rows = compare(numbers, stored)
+    for what, value, expected, ok in rows:
+        print("%-45s %14.8g %14.8g  %s" % (what, value, expected, "ok" if ok else "FAIL"))
+    failed = sum(1 for r in rows if not r[3])
+    print("%d passed, %d failed" % (len(rows) - failed, failed))
+    return 1 if failed else 0

@@ -33,6 +33,7 @@ import numpy as np
 
 from . import mesh as fem_mesh
 from . import packings, pfv_model, solve
+from .report import check_stored
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -238,20 +239,7 @@ def main():
     )
     args = ap.parse_args()
     if args.quick:
-        now = quick_numbers()
-        if args.write_reference:
-            with open(REFERENCE, "w") as f:
-                json.dump(now, f, indent=1)
-            print("wrote", REFERENCE)
-            return 0
-        with open(REFERENCE) as f:
-            ref = json.load(f)
-        rows = compare_quick(now, ref)
-        for what, value, expected, ok in rows:
-            print("%-45s %14.8g %14.8g  %s" % (what, value, expected, "ok" if ok else "FAIL"))
-        failed = sum(1 for r in rows if not r[3])
-        print("%d passed, %d failed" % (len(rows) - failed, failed))
-        return 1 if failed else 0
+        return check_stored(quick_numbers(), REFERENCE, compare_quick, args.write_reference)
 
     if args.yade_only or args.pfv_only:
         with open(args.out) as f:

@@ -6,12 +6,7 @@
 #include <string>
 
 #include "pfv/common/stage_timer.hpp"
-#include "pfv/linalg/cholesky_solver.hpp"
-#include "pfv/linalg/gauss_seidel_solver.hpp"
-#include "pfv/linalg/pcg_solver.hpp"
-#if PFV_WITH_HYPRE
-#include "pfv/linalg/amg_solver.hpp"
-#endif
+#include "pfv/engine/solver_policy.hpp"
 #include "pfv/model/conductance.hpp"
 
 namespace pfv {
@@ -42,31 +37,12 @@ void PeriodicFlowSettings::validate() const {
   require(gradient.allFinite(), "gradP must be finite");
   require(std::isfinite(bulk_modulus) && bulk_modulus >= 0, "fluidBulkModulus must be finite and not negative");
   require(solver != SolverKind::kAuto, "the periodic engine's solver must be named (no automatic choice)");
-  require(solver != SolverKind::kMultigrid || PFV_WITH_HYPRE,
-          "solver 'multigrid': PFV was built without hypre (PFV_WITH_HYPRE=OFF)");
+  const std::string unavailable = solver_unavailable(solver);
+  require(unavailable.empty(), unavailable);
   require(std::isfinite(tolerance) && tolerance > 0, "tolerance must be positive and finite");
   require(std::isfinite(relax) && relax > 0 && relax < 2, "relax must be in (0, 2)");
   require(std::isfinite(def_tolerance) && def_tolerance >= 0, "defTolerance must be finite and not negative");
 }
-
-namespace {
-
-std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
-  switch (kind) {
-    case SolverKind::kGaussSeidel:
-      return std::make_unique<GaussSeidelSolver>();
-    case SolverKind::kConjugateGradient:
-      return std::make_unique<PcgSolver>();
-#if PFV_WITH_HYPRE
-    case SolverKind::kMultigrid:
-      return std::make_unique<AmgSolver>();
-#endif
-    default:
-      return std::make_unique<CholeskySolver>();
-  }
-}
-
-}  // namespace
 
 struct PeriodicFlow::Meshed {
   // The input, for run_state().
@@ -78,6 +54,7 @@ struct PeriodicFlow::Meshed {
   FacetGeometry facets;
   std::vector<double> conductance;
   std::vector<double> gradient_source;  // s of the imposed gradient: per system and gradient, not per step
+  std::vector<double> known;            // p~ of the known pores per cell (known_pressures): likewise
   std::vector<double> orientation;      // per cell, the sign of its volume when meshed
   double mean_cell_volume = 0;
   PeriodicPressureSystem system;
@@ -154,6 +131,7 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
   if (system_due_ || (settings_.bulk_modulus > 0 && dt != system_dt_)) build_system(dt);
   if (source_due_) {
     mesh_->gradient_source = gradient_source(mesh_->cells, mesh_->facets, mesh_->conductance, settings_.gradient);
+    mesh_->known = known_pressures();
     source_due_ = false;
   }
 
@@ -182,7 +160,7 @@ void PeriodicFlow::step(const std::vector<Vec3>& centres, const std::vector<doub
   }
   for (std::size_t i = 0; i < imposed_flux_.size(); ++i) per_cell[mesh_->flux_cell[i]] += imposed_flux_[i].value;
   const PeriodicPressureSystem& system = mesh_->system;
-  const std::vector<double> known = known_pressures();
+  const std::vector<double>& known = mesh_->known;
   std::vector<double> x = system.gather(periodic_pressure_);
   if (system.n_unknowns() > 0) {  // else every pore is known (the cell is one pore, or all imposed)
     std::vector<double> b = system.gather(per_cell);
@@ -366,6 +344,7 @@ void PeriodicFlow::set_imposed_pressure(int index, double p) {
                             std::to_string(imposed_pressure_.size()) + ")");
   require(std::isfinite(p), "setImposedPressure: the pressure must be finite");
   imposed_pressure_[index].value = p;
+  source_due_ = true;  // the known pressures
 }
 
 void PeriodicFlow::clear_imposed_pressure() {

@@ -150,7 +150,8 @@ class PeriodicFlow {
   void build_system(double dt);
   // volume_ of the current mesh's cells at the last step's positions (centres_, h_).
   void measure_previous_volumes();
-  // Per cell, the known p~ of the reference pore (0) and of the imposed pores; the rest 0.
+  // Per cell, the known p~ of the reference pore (0) and of the imposed pores; the rest 0. Made
+  // with the gradient's source: per system, gradient and imposed value, not per step.
   std::vector<double> known_pressures() const;
   // The power centre of the located cell's translate that holds the point.
   Vec3 located_centre(const PeriodicTriangulation::Location& where) const;

@@ -20,25 +20,6 @@ namespace {
 
 constexpr bool kMultigridBuilt = PFV_WITH_HYPRE;
 
-std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
-  switch (kind) {
-    case SolverKind::kGaussSeidel:
-      return std::make_unique<GaussSeidelSolver>();
-    case SolverKind::kConjugateGradient:
-      return std::make_unique<PcgSolver>();
-    case SolverKind::kMultigrid:
-#if PFV_WITH_HYPRE
-      return std::make_unique<AmgSolver>();
-#else
-      throw std::invalid_argument(solver_unavailable(kind));
-#endif
-    case SolverKind::kCholesky:
-    case SolverKind::kAuto:
-      break;
-  }
-  return std::make_unique<CholeskySolver>();
-}
-
 // MemAvailable of /proc/meminfo in bytes (the kernel's estimate of what can be allocated
 // without swapping); 0 if unreadable.
 double memory_available() {
@@ -104,6 +85,25 @@ std::string cost_text(const CostInputs& c) {
 }
 
 }  // namespace
+
+std::unique_ptr<PressureSolver> make_solver(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::kGaussSeidel:
+      return std::make_unique<GaussSeidelSolver>();
+    case SolverKind::kConjugateGradient:
+      return std::make_unique<PcgSolver>();
+    case SolverKind::kMultigrid:
+#if PFV_WITH_HYPRE
+      return std::make_unique<AmgSolver>();
+#else
+      throw std::invalid_argument(solver_unavailable(kind));
+#endif
+    case SolverKind::kCholesky:
+    case SolverKind::kAuto:
+      break;
+  }
+  return std::make_unique<CholeskySolver>();
+}
 
 std::string solver_unavailable(SolverKind kind) {
   switch (kind) {

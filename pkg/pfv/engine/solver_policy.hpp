@@ -31,6 +31,9 @@ struct LinearSystem;
 
 // Empty if this build has the solver, else why not (an unknown kind, or multigrid without hypre).
 std::string solver_unavailable(SolverKind kind);
+// A new solver of this kind, not set up (kAuto: the Cholesky factor). Throws
+// std::invalid_argument (solver_unavailable's message) for multigrid in a build without hypre.
+std::unique_ptr<PressureSolver> make_solver(SolverKind kind);
 
 // Whether a system built for 'solver' must be rebuilt when the multigrid smoother changes (under
 // kAuto also while it keeps the factor: the recipe does not know the choice).

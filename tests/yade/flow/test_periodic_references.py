@@ -35,22 +35,10 @@ import sys
 
 import numpy as np
 
-from pfv_testing import checks, paths
+from pfv_testing import checks, paths, scenes
 from pfv_testing.periodic_scene import dem_engines
 from yade import O, pack, utils  # noqa: E402
 from yade.minieigenHP import Matrix3, Vector3  # noqa: E402
-from yade.wrapper import (  # noqa: E402
-    Bo1_Box_Aabb,
-    Bo1_Sphere_Aabb,
-    ForceResetter,
-    Ig2_Box_Sphere_ScGeom,
-    Ig2_Sphere_Sphere_ScGeom,
-    InsertionSortCollider,
-    InteractionLoop,
-    Ip2_FrictMat_FrictMat_FrictPhys,
-    Law2_ScGeom_FrictPhys_CundallStrack,
-    NewtonIntegrator,
-)
 from pfv import FlowEngine, PeriodicFlowEngine  # noqa: E402
 
 # YADE's PyRunner copies the locals of a function that calls O.step() into the script's globals: no local variable
@@ -210,29 +198,11 @@ def tiled_box(sides, centres, radii):
     walls impermeable. The walls cut the spheres that reach across the cell's faces (kept: the packing inside
     the box is then the periodic one everywhere, and only the pores at the walls differ). Returns the engine
     after one step."""
-    O.reset()
-    O.periodic = False
-    O.bodies.append(utils.aabbWalls([(0, 0, 0), tuple(TILES * sides)], thickness=0))  # bodies 0..5, wallIds
-    for i in range(TILES):
-        for j in range(TILES):
-            for k in range(TILES):
-                for centre, radius in zip(centres + sides * (i, j, k), radii):
-                    O.bodies.append(utils.sphere(tuple(centre), radius, fixed=True))
-    walled = FlowEngine(viscosity=1.0, boundaryUseMaxMin=[False] * 6)
-    walled.bndCondIsPressure = [False, False, True, True, False, False]
-    walled.bndCondValue = [0, 0, 1, 0, 0, 0]
-    O.engines = [
-        ForceResetter(),
-        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-        InteractionLoop(
-            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
-            [Ip2_FrictMat_FrictMat_FrictPhys()],
-            [Law2_ScGeom_FrictPhys_CundallStrack()],
-        ),
-        walled,
-        NewtonIntegrator(),
-    ]
-    O.dt = 1e-5
+    shifts = [np.array((i, j, k)) * sides for i in range(TILES) for j in range(TILES) for k in range(TILES)]
+    spheres = [(*(centre + shift), radius) for shift in shifts for centre, radius in zip(centres, radii)]
+    scenes.build_box(spheres, tuple(TILES * sides))
+    walled = scenes.configure_flow(FlowEngine(), axis=1, dp=1.0, viscosity=1.0)
+    scenes.insert_flow(walled)
     O.step()
     return walled
 

@@ -171,6 +171,24 @@ def engine_for(command: str) -> Any:
     return engine
 
 
+def running_engine(engine: Any, command: str, name: str) -> Any:
+    """The engine a PyRunner running `command` drives: `engine` (its registry's, or None) while it is in O.engines;
+    after a load the running PyRunner is a restored copy, and driving the old object would be silently wrong, so the
+    engine adopted for the command. (A scene loaded by O.load is adopted at the load or when pfv is imported; in the
+    iteration under way when it was adopted, YADE still runs the restored copies, which drive the adopted
+    engines.) Raises RuntimeError naming pfv.`name` when the scene carries no saved state for it."""
+    if engine is not None and any(e is engine for e in yade.O.engines):
+        return engine
+    adopted = engine_for(command)
+    if adopted is None:
+        raise RuntimeError(
+            f"this pfv.{name} must be re-created: YADE restored it as a plain PyRunner and the scene carries no "
+            f"saved state for it (saved before PFV could add it?); create a new pfv.{name} and put it back into "
+            "O.engines"
+        )
+    return adopted
+
+
 def _adopt_at_import() -> None:
     """A scene loaded before pfv was imported (``yade scene.yade.gz``, O.load in a script that imports pfv
     later): its engines are taken over now."""

@@ -61,20 +61,7 @@ _IDLE_CLOCK = IdleClock()
 
 
 def _run(key: int) -> None:
-    engine = registry.get(key)
-    # After a load the running PyRunner is a restored copy, not this engine (which may still be
-    # alive in this process): driving the old object would be silently wrong. A scene loaded
-    # by O.load is adopted at the load or when pfv is imported; in the iteration under way when
-    # it was adopted, YADE still runs the restored copies, which drive the adopted engines.
-    if engine is None or not any(e is engine for e in yade.O.engines):
-        engine = _persistence.engine_for(_COMMAND.format(key))
-        if engine is None:
-            raise RuntimeError(
-                "this pfv.FlowEngine must be re-created: YADE restored it as a plain PyRunner and the "
-                "scene carries no saved state for it (saved before PFV could add it?); create a new "
-                "pfv.FlowEngine and put it back into O.engines"
-            )
-    engine._step()
+    _persistence.running_engine(registry.get(key), _COMMAND.format(key), "FlowEngine")._step()
 
 
 def _gravity(scene: Any) -> tuple[float, float, float]:

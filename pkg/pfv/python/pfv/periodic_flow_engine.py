@@ -71,17 +71,7 @@ _SOLVER_CODE = {"gauss_seidel": 0, "conjugate_gradient": 1, "cholesky": 3, "mult
 
 
 def _run(key: int) -> None:
-    engine = _engines.get(key)
-    # After O.load the running PyRunner is YADE's restored copy: the engine rebuilt from the scene's saved state
-    # stands for it (_persistence), not an engine of the same key that may still live in this process.
-    if engine is None or not any(e is engine for e in yade.O.engines):
-        engine = _persistence.engine_for(_COMMAND.format(key))
-        if engine is None:
-            raise RuntimeError(
-                "this pfv.PeriodicFlowEngine must be re-created: YADE restored it as a plain PyRunner and the scene "
-                "carries no saved state for it; create a new pfv.PeriodicFlowEngine and put it back into O.engines"
-            )
-    engine._step()
+    _persistence.running_engine(_engines.get(key), _COMMAND.format(key), "PeriodicFlowEngine")._step()
 
 
 def _finite_vector(name: str, value: Any) -> tuple[float, float, float]:

@@ -109,9 +109,12 @@ def constraint(W, bcs, cell):
     return mpc, {"slaves": len(slaves)}
 
 
-def solve(mesh, facets, packing, mu=1.0, direction=(1.0, 0.0, 0.0), method="auto", blr_tolerance=1e-10, rtol=1e-10):
+def solve(
+    mesh, facets, packing, mu=1.0, direction=(1.0, 0.0, 0.0), method="auto", blr_tolerance=1e-10, rtol=1e-10, keep=None
+):
     """The flow through the periodic cell of `packing` (periodic_mesh.build's) driven by |G| = 1 along
-    `direction`: a dict of U, kappa, the forces, the balance and the solver's statistics."""
+    `direction`: a dict of U, kappa, the forces, the balance and the solver's statistics. A dict `keep` receives
+    the velocity and p~ as functions of their own spaces ("u", "p")."""
     start = time.perf_counter()
     cell = np.asarray(packing.get("cell", (1.0, 1.0, 1.0)), dtype=float)
     n_spheres = len(packing["radii"])
@@ -164,6 +167,8 @@ def solve(mesh, facets, packing, mu=1.0, direction=(1.0, 0.0, 0.0), method="auto
     w.x.scatter_forward()
     mpc.backsubstitution(w.vector)
     out = post_process(mesh, facets, packing, w, mu, gradient, direction)
+    if keep is not None:
+        keep["u"], keep["p"] = w.sub(0).collapse(), w.sub(1).collapse()
     for obj in (ksp, A, b) + ((P,) if P is not None else ()):
         obj.destroy()
     out.update(

@@ -420,9 +420,24 @@ std::vector<double> PeriodicFlow::pressure() const {
 
 Vec3 PeriodicFlow::mean_velocity() const {
   if (!mesh_ || periodic_pressure_.empty()) return Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-  const auto q =
-      periodic_fluxes(mesh_->cells, mesh_->facets, mesh_->conductance, periodic_pressure_, settings_.gradient);
-  return pfv::mean_velocity(mesh_->cells, mesh_->facets, q, mesh_->periodic().cell.volume());
+  return pfv::mean_velocity(mesh_->cells, mesh_->facets, throat_fluxes(), mesh_->periodic().cell.volume());
+}
+
+const FacetGeometry& PeriodicFlow::facets() const {
+  if (!mesh_) throw std::logic_error("PeriodicFlow: no mesh before the first step");
+  return mesh_->facets;
+}
+
+const std::vector<double>& PeriodicFlow::conductances() const {
+  if (!mesh_) throw std::logic_error("PeriodicFlow: no mesh before the first step");
+  return mesh_->conductance;
+}
+
+std::vector<double> PeriodicFlow::throat_fluxes() const {
+  if (!mesh_) throw std::logic_error("PeriodicFlow: no mesh before the first step");
+  if (periodic_pressure_.empty())
+    return std::vector<double>(mesh_->facets.size(), std::numeric_limits<double>::quiet_NaN());
+  return periodic_fluxes(mesh_->cells, mesh_->facets, mesh_->conductance, periodic_pressure_, settings_.gradient);
 }
 
 double PeriodicFlow::pressure_at(const Vec3& x) const {

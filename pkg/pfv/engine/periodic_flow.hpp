@@ -105,6 +105,11 @@ class PeriodicFlow {
   const std::vector<double>& current_volumes() const { return volume_; }
   // The superficial velocity (1/V) sum_f q_f d_f.
   Vec3 mean_velocity() const;
+  // The throats of the current mesh (needs a mesh): their geometry at the remesh, conductances,
+  // and the flux of the last step's pressure from cell[f][0] to cell[f][1] (NaN before a solve).
+  const FacetGeometry& facets() const;
+  const std::vector<double>& conductances() const;
+  std::vector<double> throat_fluxes() const;
   // The pressure of the pore holding x (anywhere, in any period): p~ + gradP . P, P the power
   // centre of that pore's translate (a cell's pressure, as YADE's getPorePressure); NaN before
   // the first step.

@@ -46,6 +46,34 @@ PeriodicFlow::RunState from_dict(const py::dict& d) {
   return s;
 }
 
+template <std::size_t N, typename T>
+py::array_t<T> rows_to_array(const std::vector<std::array<T, N>>& rows) {
+  py::array_t<T> out({rows.size(), N});
+  auto o = out.template mutable_unchecked<2>();
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (std::size_t j = 0; j < N; ++j) o(i, j) = rows[i][j];
+  return out;
+}
+
+// The throats of the current mesh as arrays, one row per facet (the throat-level comparison with
+// the Stokes reference in validation/stokes/ reads them).
+py::dict throats(const PeriodicFlow& f) {
+  const FacetGeometry& g = f.facets();
+  py::dict d;
+  d["cells"] = rows_to_array(g.cell);
+  d["vertices"] = rows_to_array(g.vertex);
+  d["translation"] = points_to_array(g.translation);
+  d["area_vector"] = points_to_array(g.area_vector);
+  d["fluid_area"] = vector_to_array(g.fluid_area);
+  d["length"] = vector_to_array(g.length);
+  d["hydraulic_radius"] = vector_to_array(g.hydraulic_radius);
+  d["sector_area"] = rows_to_array(g.sector_area);
+  d["wetted_area"] = rows_to_array(g.wetted_area);
+  d["conductance"] = vector_to_array(f.conductances());
+  d["flux"] = vector_to_array(f.throat_fluxes());
+  return d;
+}
+
 SolverKind solver_kind(const std::string& name) {
   for (SolverKind k :
        {SolverKind::kCholesky, SolverKind::kGaussSeidel, SolverKind::kConjugateGradient, SolverKind::kMultigrid})
@@ -123,6 +151,10 @@ void bind_periodic(py::module_& m) {
       .def("current_cell_volumes", [](const PeriodicFlow& f) { return vector_to_array(f.current_volumes()); })
       .def("forces", [](const PeriodicFlow& f) { return points_to_array(f.forces()); })
       .def("mean_velocity", &PeriodicFlow::mean_velocity)
+      .def("throats", &throats,
+           "Per facet of the current mesh: cells (m, 2), vertices (image ids), translation of cell 1, area_vector, "
+           "fluid_area, length, hydraulic_radius, sector_area, wetted_area, conductance, flux (cell 0 to 1).")
+      .def("power_centres", [](const PeriodicFlow& f) { return points_to_array(f.cells().power_centre); })
       .def("pressure_at", &PeriodicFlow::pressure_at, py::arg("x"));
 }
 

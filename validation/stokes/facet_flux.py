@@ -1,0 +1,125 @@
+"""The Stokes reference's flux through the throats of PFV's regular triangulation.
+
+A throat of the pore network is the facet shared by two tetrahedra: the triangle of three sphere centres. The
+reference's flux through it is the integral of u . n over that triangle, by quadrature of the finite-element
+velocity (a degree-2 three-point rule on each triangle of a regular m x m subdivision, m set by the element size so
+that the sub-triangles are a third of an element across). The velocity is 0 in the spheres (points there are
+known from the geometry) and periodic (points are wrapped into the cell). Points of the fluid that no cell holds,
+between a curved sphere surface and its mesh, count as solid: their area is far below the quadrature's error.
+
+The divergence-free field makes the fluxes out of each tetrahedron sum to zero; the sum of their magnitudes gives
+the quadrature's own error (``imbalance``), which the study reports beside every comparison.
+"""
+import numpy as np
+from dolfinx import geometry
+from scipy.spatial import cKDTree
+
+# Rule of degree 2 on a triangle: barycentric points and equal weights (1/3 each, times the area).
+_RULE = np.array([[2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+
+
+def subdivision(m):
+    """Barycentric quadrature points (n, 3) and weights (sum 1) of the m x m subdivision of a triangle."""
+    points = []
+    for i in range(m):
+        for j in range(m - i):
+            up = np.array([[i, j], [i + 1, j], [i, j + 1]], dtype=float) / m
+            points.append(_RULE @ up)
+            if i + j < m - 1:
+                down = np.array([[i + 1, j], [i + 1, j + 1], [i, j + 1]], dtype=float) / m
+                points.append(_RULE @ down)
+    st = np.concatenate(points)
+    bary = np.column_stack([1.0 - st.sum(1), st])
+    return bary, np.full(len(bary), 1.0 / len(bary))
+
+
+def in_solid(points, centres, radii, cell):
+    """Whether each point (wrapped into the cell) lies in a sphere or one of its periodic images."""
+    cell = np.asarray(cell, dtype=float)
+    tree = cKDTree(np.mod(centres, cell), boxsize=cell)
+    reach = float(np.max(radii))
+    solid = np.zeros(len(points), dtype=bool)
+    for i, near in enumerate(tree.query_ball_point(points, reach)):
+        if near:
+            d = points[i] - centres[near]
+            d -= np.round(d / cell) * cell
+            solid[i] = bool((np.einsum("ij,ij->i", d, d) < np.asarray(radii)[near] ** 2).any())
+    return solid
+
+
+def velocity_at(mesh, u, points):
+    """u (a collapsed P2 vector function) at the points; zero where no cell holds the point."""
+    tree = geometry.BoundingBoxTree(mesh, mesh.topology.dim)
+    candidates = geometry.compute_collisions(tree, points)
+    colliding = geometry.compute_colliding_cells(mesh, candidates, points)
+    offsets = colliding.offsets
+    found = np.nonzero(offsets[1:] > offsets[:-1])[0]
+    out = np.zeros((len(points), 3))
+    if len(found):
+        cells = colliding.array[offsets[found]]
+        out[found] = u.eval(points[found], cells)
+    return out, len(points) - len(found)
+
+
+def pressure_at(mesh, p, points, gradient, cell):
+    """The pressure p~ + G . x at points (unwrapped; p~ is evaluated at their wrapped images), NaN where no
+    cell holds the point."""
+    wrapped = np.ascontiguousarray(np.mod(points, np.asarray(cell, dtype=float)))
+    tree = geometry.BoundingBoxTree(mesh, mesh.topology.dim)
+    colliding = geometry.compute_colliding_cells(mesh, geometry.compute_collisions(tree, wrapped), wrapped)
+    out = np.full(len(points), np.nan)
+    for i in range(len(points)):
+        links = colliding.links(i)
+        if len(links):
+            out[i] = p.eval(wrapped[i : i + 1], links[:1])[0]
+    return out + np.asarray(points) @ np.asarray(gradient, dtype=float)
+
+
+def fluxes(mesh, u, triangles, normals, centres, radii, cell, element_size, chunk=400_000):
+    """Per triangle (m, 3 vertices, 3), the flux of u through it along its unit normal (m, 3)."""
+    cell = np.asarray(cell, dtype=float)
+    triangles = np.asarray(triangles, dtype=float)
+    out = np.zeros(len(triangles))
+    edges = np.linalg.norm(triangles - np.roll(triangles, 1, axis=1), axis=2).max(1)
+    subdivisions = np.maximum(2, np.ceil(3.0 * edges / element_size).astype(int))
+    missing = 0
+    batch, owners, weights = [], [], []
+
+    def flush():
+        nonlocal missing, batch, owners, weights
+        if not batch:
+            return
+        pts = np.mod(np.concatenate(batch), cell)
+        own = np.concatenate(owners)
+        w = np.concatenate(weights)
+        fluid = ~in_solid(pts, centres, radii, cell)
+        vel = np.zeros_like(pts)
+        vel[fluid], lost = velocity_at(mesh, u, np.ascontiguousarray(pts[fluid]))
+        missing += lost
+        np.add.at(out, own, w * np.einsum("ij,ij->i", vel, normals[own]))
+        batch, owners, weights = [], [], []
+
+    rules = {}
+    count = 0
+    for f, (tri, m) in enumerate(zip(triangles, subdivisions)):
+        if m not in rules:
+            rules[m] = subdivision(int(m))
+        bary, w = rules[m]
+        area = 0.5 * np.linalg.norm(np.cross(tri[1] - tri[0], tri[2] - tri[0]))
+        batch.append(bary @ tri)
+        owners.append(np.full(len(w), f))
+        weights.append(w * area)
+        count += len(w)
+        if count > chunk:
+            flush()
+            count = 0
+    flush()
+    return out, missing
+
+
+def imbalance(cells, flux, n_cells):
+    """|sum of the fluxes out of each pore| summed, over the sum of |flux| out of each pore: 0 for exact fluxes."""
+    i, j = np.asarray(cells)[:, 0], np.asarray(cells)[:, 1]
+    net = np.bincount(i, flux, n_cells) - np.bincount(j, flux, n_cells)
+    gross = np.bincount(i, np.abs(flux), n_cells) + np.bincount(j, np.abs(flux), n_cells)
+    return float(np.abs(net).sum() / gross.sum())

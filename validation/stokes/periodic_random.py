@@ -1,0 +1,166 @@
+"""The periodic Stokes reference on the random packings of periodic_packings.py, and PFV's throats against it.
+
+    export PYTHONPATH=$BUILD/python OMP_NUM_THREADS=1
+    /usr/bin/python3 -m validation.stokes.periodic_random --packings=dense_mono_s1 [--levels=...] [--out=FILE]
+    /usr/bin/python3 -m validation.stokes.periodic_random --report [--out=FILE]
+
+For every packing, contact shrink and element size (sphere surface, periodic_mesh.py's `surface`) it meshes the
+periodic cell, solves the Stokes flow driven by |G| = 1 along x (periodic_solve.py) and appends a row to --out:
+kappa_xx, the solver's figures, and the flux through every throat of PFV's regular triangulation of the same
+(shrunk) spheres (facet_flux.py), with PFV's own flux and geometry of that throat beside it (pfv_periodic.py).
+Packings with contacts (gap 0) are solved at the shrinks of doc/validation.md section 7 and extrapolated to
+touching; packings with a gap at every pair are solved as they are. Rows already in --out are not recomputed.
+"""
+import argparse
+import json
+import os
+import resource
+import sys
+import time
+
+import numpy as np
+
+from . import facet_flux, periodic_mesh, periodic_packings, periodic_solve, pfv_periodic
+from .mesh import tangled_cells
+from .packings import shrunk
+from .report import MIN_SHRINK_ORDER, richardson
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "data", "periodic_random.json")
+LEVELS = (0.045, 0.034, 0.025)
+SHRINKS = (0.01, 0.005, 0.0025)
+
+
+def shrinks_of(packing):
+    return SHRINKS if packing["gap"] == 0 else (0.0,)
+
+
+def run_one(name, shrink, surface, solver="auto"):
+    """One mesh, one solve, the throat fluxes: the row of the results file."""
+    p = shrunk(periodic_packings.load(name), shrink) if shrink else periodic_packings.load(name)
+    model = pfv_periodic.run(p)
+    start = time.perf_counter()
+    msh, _, facets = periodic_mesh.build(p, surface)
+    meshed = time.perf_counter() - start
+    keep = {}
+    r = periodic_solve.solve(msh, facets, p, method=solver, keep=keep)
+    t = model["throats"]
+    area = np.linalg.norm(t["area_vector"], axis=1)
+    normals = t["area_vector"] / area[:, None]
+    start = time.perf_counter()
+    q, missing = facet_flux.fluxes(msh, keep["u"], t["triangle"], normals, p["centres"], p["radii"], p["cell"],
+                                   surface)
+    r.pop("forces")
+    pore_pressure = facet_flux.pressure_at(msh, keep["p"], model["power_centres"], (-1.0, 0.0, 0.0), p["cell"])
+    return {
+        "packing": name,
+        "shrink": shrink,
+        "surface": surface,
+        "n_spheres": len(p["radii"]),
+        "folded_cells": tangled_cells(msh),
+        "seconds_mesh": meshed,
+        "seconds_throats": time.perf_counter() - start,
+        "peak_rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20,
+        "kappa_pfv": model["kappa"],
+        "n_pores": model["n_cells"],
+        "throat_vertices": t["vertices"].tolist(),
+        "throat_flux_fem": q.tolist(),
+        "throat_flux_pfv": t["flux"].tolist(),
+        "throat_points_missed": int(missing),
+        "throat_imbalance": facet_flux.imbalance(t["cells"], q, model["n_cells"]),
+        "pore_pressure_fem": pore_pressure.tolist(),  # at PFV's power centres, NaN where in no element
+        "pore_pressure_pfv": model["pressure"].tolist(),
+        **r,
+    }
+
+
+def key_of(row):
+    return (row["packing"], row["shrink"], row["surface"])
+
+
+def run_cases(names, levels, out, solver="auto", log=print):
+    rows = load(out)
+    done = {key_of(r) for r in rows}
+    for name in names:
+        packing = periodic_packings.load(name)
+        for shrink in shrinks_of(packing):
+            for surface in levels:
+                if (name, shrink, surface) in done:
+                    continue
+                row = run_one(name, shrink, surface, solver)
+                rows.append(row)
+                save(rows, out)
+                log(
+                    "%-14s shrink %.4f h %.3f dofs %8d kappa %.5e pfv/fem %.3f imbalance %.1e %s %.0f s %.1f GB"
+                    % (name, shrink, surface, row["dofs"], row["kappa"], row["kappa_pfv"] / row["kappa"],
+                       row["throat_imbalance"], row["solver"], row["seconds_solve"], row["peak_rss_gb"]),
+                    flush=True,
+                )
+    return rows
+
+
+def load(path):
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return json.load(f)
+
+
+def save(rows, path):
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w") as f:
+        json.dump(rows, f)
+
+
+def limits(rows):
+    """{packing: {shrink: (kappa at h -> 0, order, kappa_pfv)}} from the rows (Richardson through the last three
+    levels; with two, the finest level and nan)."""
+    by = {}
+    for r in rows:
+        by.setdefault(r["packing"], {}).setdefault(r["shrink"], []).append(r)
+    out = {}
+    for name, shrinks in by.items():
+        for shrink, levels in shrinks.items():
+            levels.sort(key=lambda r: -r["surface"])
+            if len(levels) >= 3:
+                k, q = richardson([r["surface"] for r in levels[-3:]], [r["kappa"] for r in levels[-3:]])
+            else:
+                k, q = levels[-1]["kappa"], float("nan")
+            out.setdefault(name, {})[shrink] = (k, q, levels[-1]["kappa_pfv"])
+    return out
+
+
+def touching(values):
+    """kappa at zero shrink from {shrink: kappa} (Richardson in the shrink), with its spread (the distance of the
+    limit from the straight line through the two smallest shrinks)."""
+    s = sorted(values, reverse=True)
+    k = [values[x] for x in s]
+    limit, order = richardson(s, k, MIN_SHRINK_ORDER)
+    line = k[-1] - (k[-2] - k[-1]) * s[-1] / (s[-2] - s[-1])
+    return limit, order, abs(line / limit - 1)
+
+
+def report(rows):
+    lines = ["| packing | shrink | κ_FEM (h → 0) | order | κ_PFV / κ_FEM |", "|---|---|---|---|---|"]
+    for name, shrinks in limits(rows).items():
+        for shrink, (k, q, k_pfv) in sorted(shrinks.items(), reverse=True):
+            lines.append("| %s | %g | %.5e | %.1f | %.3f |" % (name, shrink, k, q, k_pfv / k))
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--packings", default=",".join(periodic_packings.PACKINGS))
+    ap.add_argument("--levels", default=",".join(str(h) for h in LEVELS))
+    ap.add_argument("--solver", choices=("auto", "direct", "minres"), default="auto")
+    ap.add_argument("--out", default=RESULTS)
+    ap.add_argument("--report", action="store_true")
+    args = ap.parse_args()
+    levels = [float(x) for x in args.levels.split(",")]
+    rows = load(args.out) if args.report else run_cases(args.packings.split(","), levels, args.out, args.solver)
+    print(report(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

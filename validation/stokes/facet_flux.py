@@ -47,31 +47,65 @@ def in_solid(points, centres, radii, cell):
     return solid
 
 
-def velocity_at(mesh, u, points):
-    """u (a collapsed P2 vector function) at the points; zero where no cell holds the point."""
+def locate(mesh, points, tolerance=1e-9):
+    """Per point, a cell holding it (-1: none), by the barycentric coordinates in the straight tetrahedron of the
+    cell's corners among the bounding-box candidates. dolfinx's compute_colliding_cells stops with "GJK error: max
+    iteration limit reached" on curved cells; a point between a curved face and its chord is then given the
+    neighbour's cell or none, and its value is extrapolated from the cell found or taken as solid."""
     tree = geometry.BoundingBoxTree(mesh, mesh.topology.dim)
     candidates = geometry.compute_collisions(tree, points)
-    colliding = geometry.compute_colliding_cells(mesh, candidates, points)
-    offsets = colliding.offsets
-    found = np.nonzero(offsets[1:] > offsets[:-1])[0]
+    offsets, links = candidates.offsets, candidates.array
+    owner = np.repeat(np.arange(len(points)), np.diff(offsets))
+    x = mesh.geometry.x
+    corners = x[mesh.geometry.dofmap.array.reshape(-1, mesh.geometry.dofmap.offsets[1])[:, :4]]
+    out = np.full(len(points), -1, dtype=np.int32)
+    for start in range(0, len(links), 2_000_000):
+        cell, own = links[start : start + 2_000_000], owner[start : start + 2_000_000]
+        c = corners[cell]
+        m = np.stack([c[:, 1] - c[:, 0], c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]], axis=2)
+        lam = np.linalg.solve(m, (points[own] - c[:, 0])[:, :, None])[:, :, 0]
+        inside = np.minimum(lam.min(1), 1.0 - lam.sum(1)) >= -tolerance
+        out[own[inside]] = cell[inside]
+    return out
+
+
+def evaluate(f, points, cells, size):
+    """f at the points in their cells, (n, size); NaN at a point whose cell's pull-back fails (a point just
+    outside a curved cell: dolfinx's Newton iteration then stops with an error for the whole call, so the
+    calls are split until the failing points are alone)."""
+    try:
+        return f.eval(points, cells).reshape(len(points), size)
+    except RuntimeError:
+        if len(points) == 1:
+            return np.full((1, size), np.nan)
+        half = len(points) // 2
+        return np.concatenate(
+            [evaluate(f, points[:half], cells[:half], size), evaluate(f, points[half:], cells[half:], size)]
+        )
+
+
+def velocity_at(mesh, u, points):
+    """u (a collapsed P2 vector function) at the points; zero where no cell holds the point or the cell's
+    pull-back fails. Also returns the count of such points."""
+    cells = locate(mesh, points)
+    found = np.nonzero(cells >= 0)[0]
     out = np.zeros((len(points), 3))
     if len(found):
-        cells = colliding.array[offsets[found]]
-        out[found] = u.eval(points[found], cells)
-    return out, len(points) - len(found)
+        out[found] = evaluate(u, points[found], cells[found], 3)
+    lost = ~np.isfinite(out).all(1)
+    out[lost] = 0.0
+    return out, len(points) - len(found) + int(lost.sum())
 
 
 def pressure_at(mesh, p, points, gradient, cell):
     """The pressure p~ + G . x at points (unwrapped; p~ is evaluated at their wrapped images), NaN where no
     cell holds the point."""
     wrapped = np.ascontiguousarray(np.mod(points, np.asarray(cell, dtype=float)))
-    tree = geometry.BoundingBoxTree(mesh, mesh.topology.dim)
-    colliding = geometry.compute_colliding_cells(mesh, geometry.compute_collisions(tree, wrapped), wrapped)
+    cells = locate(mesh, wrapped)
     out = np.full(len(points), np.nan)
-    for i in range(len(points)):
-        links = colliding.links(i)
-        if len(links):
-            out[i] = p.eval(wrapped[i : i + 1], links[:1])[0]
+    found = np.nonzero(cells >= 0)[0]
+    if len(found):
+        out[found] = evaluate(p, wrapped[found], cells[found], 1)[:, 0]
     return out + np.asarray(points) @ np.asarray(gradient, dtype=float)
 
 

@@ -15,6 +15,7 @@ import itertools
 
 import gmsh
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .mesh import BULK_PER_SURFACE, SPHERE_TAG, generate, mesh_options
 
@@ -100,26 +101,36 @@ def _make_periodic(groups, cell, tol=1e-5):
             gmsh.model.mesh.setPeriodic(2, [slave], match, translation.ravel().tolist())
 
 
-def _size_field(spheres, surface, layer):
-    """Threshold of the exact distance to each sphere image near the cell, their minimum as background."""
-    field = gmsh.model.mesh.field
-    fields = []
-    for _, x, r in spheres:
-        dist = field.add("MathEval")
-        field.setString(dist, "F", "Sqrt((x-(%.17g))^2+(y-(%.17g))^2+(z-(%.17g))^2)-(%.17g)" % (tuple(x) + (r,)))
-        near = field.add("Threshold")
-        field.setNumber(near, "InField", dist)
-        field.setNumber(near, "SizeMin", surface)
-        field.setNumber(near, "SizeMax", BULK_PER_SURFACE * surface)
-        field.setNumber(near, "DistMin", 0.0)
-        field.setNumber(near, "DistMax", layer)
-        fields.append(near)
-    smallest = field.add("Min")
-    field.setNumbers(smallest, "FieldsList", fields)
-    field.setAsBackgroundMesh(smallest)
+def _size_field(spheres, surface, layer, gap_elements=0.0, smallest=0.25):
+    """Element size `surface` on the spheres, growing linearly to BULK_PER_SURFACE times that at the distance
+    `layer` from the nearest sphere image (exact distances, images inside and outside the cell alike).
+
+    With gap_elements > 0, also at most the local width of a gap between two spheres (the distances to the
+    two nearest sphere surfaces summed) over gap_elements, but not below `smallest` times `surface`: a
+    curved element whose straight edges cross a gap much narrower than itself folds (section 7 of
+    doc/validation.md), and on a random packing's many near-contacts the folds leave MINRES' preconditioner
+    indefinite. Gaps narrower than that floor are left to the elastic untangling.
+
+    A callback rather than one gmsh field per image: a random packing of 100 spheres has some 400 images near
+    the cell, and gmsh evaluates every field at every size query."""
+    centres = np.array([x for _, x, _ in spheres])
+    radii = np.array([r for _, _, r in spheres])
+    tree = cKDTree(centres)
+    # the two nearest surfaces are among the nearest centres (radii differ by at most a factor 2 here)
+    k = min(len(centres), 12)
+
+    def size(dim, tag, x, y, z):
+        distance, index = tree.query((x, y, z), k=k)
+        gaps = np.sort(np.maximum(np.atleast_1d(distance) - radii[np.atleast_1d(index)], 0.0))
+        out = surface * (1.0 + (BULK_PER_SURFACE - 1.0) * min(gaps[0] / layer, 1.0))
+        if gap_elements > 0 and len(gaps) > 1:
+            out = min(out, max((gaps[0] + gaps[1]) / gap_elements, smallest * surface))
+        return out
+
+    gmsh.model.mesh.setSizeCallback(size)
 
 
-def build(packing, surface, layer=0.32, order=2, verbose=False):
+def build(packing, surface, layer=0.32, order=2, verbose=False, gap_elements=0.0):
     """The dolfinx mesh, cell tags and facet tags of the fluid in the periodic cell of `packing` (its
     ``cell``, the side lengths, default the unit cube; ``centres`` inside the cell; ``radii``)."""
     cell = np.asarray(packing.get("cell", (1.0, 1.0, 1.0)), dtype=float)
@@ -142,7 +153,7 @@ def build(packing, surface, layer=0.32, order=2, verbose=False):
         for marker, tags in groups.items():
             gmsh.model.addPhysicalGroup(2, tags, marker)
         _make_periodic(groups, cell)
-        _size_field(near, surface, layer)
+        _size_field(near, surface, layer, gap_elements)
         mesh_options()
         mesh, cells, facets = generate(order)
     finally:

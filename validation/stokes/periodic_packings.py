@@ -34,6 +34,15 @@ PACKINGS = {
     "bed_mono_s1": (100, 1.0, 0.45, 0.05, 1),
     "bed_mono_s2": (100, 1.0, 0.45, 0.05, 2),
 }
+# Small cells of 16 spheres: many geometries at a small cost, for fitting throat-level models that the packings
+# of 100 spheres then test.
+SMALL = {
+    "small_%s_c%02d_s%d" % (kind, round(100 * c), seed): (16, ratio, c, gap, seed)
+    for kind, ratio in (("mono", 1.0), ("poly", 0.5))
+    for c, gap in ((0.40, 0.03), (0.50, 0.03), (0.58, 0.01), (0.60, 0.0))
+    for seed in (11, 12)
+}
+PACKINGS.update(SMALL)
 
 # A sphere this close to tangency with a face of the cell is moved off it (periodic_mesh refuses it).
 FACE_CLEARANCE = 2e-3
@@ -68,7 +77,11 @@ def generate(n, ratio, c, gap, seed):
     x = rng.uniform(0.0, 1.0, (n, 3))
     for _ in range(20):
         res = minimize(
-            _energy, x.ravel(), args=(reach,), jac=True, method="L-BFGS-B",
+            _energy,
+            x.ravel(),
+            args=(reach,),
+            jac=True,
+            method="L-BFGS-B",
             options={"maxiter": 20000, "ftol": 1e-30, "gtol": 1e-16},
         )
         x = np.mod(res.x.reshape(-1, 3), 1.0)

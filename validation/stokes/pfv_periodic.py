@@ -53,8 +53,10 @@ def network_kappa(throats, conductance, n_cells, volume=1.0, direction=(1.0, 0.0
     branch = throats["power_centre_1"] - throats["power_centre_0"]
     k = np.asarray(conductance, dtype=float)
     drop = -branch @ gradient  # p_0 - p_1 of the mean gradient alone
-    g = sp.coo_matrix((np.concatenate([k, k, -k, -k]), (np.concatenate([i, j, i, j]), np.concatenate([i, j, j, i]))),
-                      shape=(n_cells, n_cells)).tocsr()
+    g = sp.coo_matrix(
+        (np.concatenate([k, k, -k, -k]), (np.concatenate([i, j, i, j]), np.concatenate([i, j, j, i]))),
+        shape=(n_cells, n_cells),
+    ).tocsr()
     rhs = -np.bincount(i, k * drop, n_cells) + np.bincount(j, k * drop, n_cells)
     # p~ is fixed to 0 in pore 0, the constant being the system's only null mode
     p = np.zeros(n_cells)

@@ -8,6 +8,7 @@
 #include "pfv/common/stage_timer.hpp"
 #include "pfv/engine/solver_policy.hpp"
 #include "pfv/model/conductance.hpp"
+#include "triangulation/constriction.hpp"
 
 namespace pfv {
 namespace {
@@ -56,6 +57,9 @@ struct PeriodicFlow::Meshed {
   std::vector<double> gradient_source;  // s of the imposed gradient: per system and gradient, not per step
   std::vector<double> known;            // p~ of the known pores per cell (known_pressures): likewise
   std::vector<double> orientation;      // per cell, the sign of its volume when meshed
+  // Per image, its sphere's wrap plus its own offset in periods (wrap + o_v): each step's image
+  // is the sphere's centre plus h times this.
+  std::vector<Vec3> image_translation;
   double mean_cell_volume = 0;
   PeriodicPressureSystem system;
   ForceCache cache;
@@ -88,13 +92,9 @@ const PeriodicMesh& PeriodicFlow::mesh() const {
 void PeriodicFlow::image_positions(const std::vector<Vec3>& centres, const Eigen::Matrix3d& h,
                                    std::vector<Vec3>& out) const {
   const PeriodicMesh& m = mesh_->periodic();
+  const std::vector<Vec3>& translation = mesh_->image_translation;
   out.resize(m.n_images());
-  for (int v = 0; v < m.n_images(); ++v) {
-    const int s = m.image_sphere[v];
-    const Offset& w = m.wrap[s];
-    const Offset& o = m.image_offset[v];
-    out[v] = centres[s] + h * Vec3(w[0] + o[0], w[1] + o[1], w[2] + o[2]);
-  }
+  for (int v = 0; v < m.n_images(); ++v) out[v] = centres[m.image_sphere[v]] + h * translation[v];
 }
 
 void PeriodicFlow::check_mesh_input(const std::vector<Vec3>& centres, const std::vector<double>& radii,
@@ -216,6 +216,12 @@ std::unique_ptr<PeriodicFlow::Meshed> PeriodicFlow::build_mesh(const std::vector
   for (int c = 0; c < m.n_cells(); ++c)
     next->orientation[c] = tetrahedron_volume(m.mesh.cell_vertices[c], m.image_centre) < 0 ? -1.0 : 1.0;
   next->mean_cell_volume = m.cell.volume() / m.n_cells();
+  next->image_translation.resize(m.n_images());
+  for (int v = 0; v < m.n_images(); ++v) {
+    const Offset& w = m.wrap[m.image_sphere[v]];
+    const Offset& o = m.image_offset[v];
+    next->image_translation[v] = Vec3(w[0] + o[0], w[1] + o[1], w[2] + o[2]);
+  }
   remesh_times_.geometry = seconds_since(t0);
   t0 = StageClock::now();
   next->cache.build(m.mesh, next->facets, packing);
@@ -438,6 +444,16 @@ std::vector<double> PeriodicFlow::throat_fluxes() const {
   if (periodic_pressure_.empty())
     return std::vector<double>(mesh_->facets.size(), std::numeric_limits<double>::quiet_NaN());
   return periodic_fluxes(mesh_->cells, mesh_->facets, mesh_->conductance, periodic_pressure_, settings_.gradient);
+}
+
+std::vector<double> PeriodicFlow::throat_constrictions() const {
+  const PeriodicMesh& m = mesh();
+  static const BoxWalls no_walls{};
+  const Packing packing{m.image_centre, m.image_radius, no_walls, &m.cell.h};
+  std::vector<double> radius(mesh_->facets.size());
+  for (int f = 0; f < mesh_->facets.size(); ++f)
+    radius[f] = throat_constriction(m.mesh, mesh_->facets.vertex[f], packing).radius;
+  return radius;
 }
 
 double PeriodicFlow::pressure_at(const Vec3& x) const {

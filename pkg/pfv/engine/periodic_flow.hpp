@@ -110,6 +110,8 @@ class PeriodicFlow {
   const FacetGeometry& facets() const;
   const std::vector<double>& conductances() const;
   std::vector<double> throat_fluxes() const;
+  // Per facet, the radius of its constriction (triangulation/constriction.hpp) at the remesh.
+  std::vector<double> throat_constrictions() const;
   // The pressure of the pore holding x (anywhere, in any period): p~ + gradP . P, P the power
   // centre of that pore's translate (a cell's pressure, as YADE's getPorePressure); NaN before
   // the first step.

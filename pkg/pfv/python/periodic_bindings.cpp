@@ -71,6 +71,7 @@ py::dict throats(const PeriodicFlow& f) {
   d["wetted_area"] = rows_to_array(g.wetted_area);
   d["conductance"] = vector_to_array(f.conductances());
   d["flux"] = vector_to_array(f.throat_fluxes());
+  d["constriction_radius"] = vector_to_array(f.throat_constrictions());
   return d;
 }
 
@@ -153,7 +154,8 @@ void bind_periodic(py::module_& m) {
       .def("mean_velocity", &PeriodicFlow::mean_velocity)
       .def("throats", &throats,
            "Per facet of the current mesh: cells (m, 2), vertices (image ids), translation of cell 1, area_vector, "
-           "fluid_area, length, hydraulic_radius, sector_area, wetted_area, conductance, flux (cell 0 to 1).")
+           "fluid_area, length, hydraulic_radius, sector_area, wetted_area, conductance, flux (cell 0 to 1), "
+           "constriction_radius.")
       .def("power_centres", [](const PeriodicFlow& f) { return points_to_array(f.cells().power_centre); })
       .def("pressure_at", &PeriodicFlow::pressure_at, py::arg("x"));
 }

@@ -502,7 +502,8 @@ class PeriodicFlowEngine(PyRunner):
             self._scan(scene)
             self._core.request_remesh()
             centres = self._centres(scene)
-        h = np.array([[scene.cell.hSize[i, j] for j in range(3)] for i in range(3)])
+        hsize = scene.cell.hSize  # a copy at each access: read once
+        h = np.array([[hsize[i, j] for j in range(3)] for i in range(3)])
         clock.lap("positions")
         count = self._core.remesh_count
         self._core.step(centres, self._spheres[1], h, scene.dt)

@@ -1,11 +1,20 @@
 """Candidate throat conductances, evaluated on the pore network of PFV's triangulation against the Stokes reference.
 
+    export PYTHONPATH=$BUILD/python
+    /usr/bin/python3 -m validation.stokes.conductance_candidates     # the table of doc/validation.md section 7.7
+
 Every candidate maps the throat's own geometry (pfv_periodic.run's throats and throat_study.features) to mu k, the
 conductance times the viscosity (a volume): no per-packing input. The network with those conductances is solved by
 pfv_periodic.network_kappa, the same periodic system as the engine's, so a candidate is tried without rebuilding
 the engine.
 """
+import itertools
+import sys
+import warnings
+
 import numpy as np
+
+from . import periodic_mesh, periodic_random, periodic_run, pfv_periodic, throat_study
 
 
 def facet_perimeter(throats):
@@ -22,8 +31,9 @@ def facet_perimeter(throats):
 
 
 def thesis(t, g):
-    """Thesis eq. 3.5-3.6: A_f R_h^2 / (2 L)."""
-    return 0.5 * g["fluid_area"] * g["hydraulic_radius"] ** 2 / g["length"]
+    """Thesis eq. 3.5-3.6: A_f R_h^2 / (2 L), infinite for a flat pair of pores (L = 0: the clamp bounds it)."""
+    with np.errstate(divide="ignore"):
+        return 0.5 * g["fluid_area"] * g["hydraulic_radius"] ** 2 / g["length"]
 
 
 def constriction(t, g):
@@ -37,10 +47,124 @@ def facet_radius(t, g):
     return 0.5 * g["fluid_area"] * r2**2 / g["length"]
 
 
-CANDIDATES = {"thesis": thesis, "constriction": constriction, "facet_radius": facet_radius}
+def entrance(t, g, beta=3.0 * np.pi / 8.0, radius="area"):
+    """The thesis' duct in series with an orifice (Dagan, Weinberg & Tamir 1982: a tube of radius a and length L
+    conducts pi a^4 / (8 mu L) / (1 + 3 pi a / (8 L)), Poiseuille's duct and Sampson's orifice in series): the
+    thesis' conductance divided by 1 + beta a / L, a the facet's equivalent radius sqrt(A_f / pi) ("area") or
+    2 R_h ("hydraulic"). A short, wide throat is no longer conducting without bound as L / a falls."""
+    a = np.sqrt(g["fluid_area"] / np.pi) if radius == "area" else 2.0 * g["hydraulic_radius"]
+    return 0.5 * g["fluid_area"] * g["hydraulic_radius"] ** 2 / (g["length"] + beta * a)
+
+
+def orifice(t, g, gamma=3.0):
+    """The thesis' duct and Sampson's orifice in series as resistances: mu / k = mu L / (A_f R_h^2 / 2) +
+    gamma mu / a^3, a = sqrt(A_f / pi) (Sampson: gamma = 3 for a circular hole in a thin wall)."""
+    a3 = (g["fluid_area"] / np.pi) ** 1.5
+    return 1.0 / (g["length"] / (0.5 * g["fluid_area"] * g["hydraulic_radius"] ** 2) + gamma / a3)
+
+
+CANDIDATES = {
+    "thesis": thesis,
+    "constriction": constriction,
+    "facet_radius": facet_radius,
+    "entrance": entrance,
+    "orifice": orifice,
+}
 
 
 def clamped(k, low=1e-4, high=100.0):
-    """The engine's clamp: k within [low, high] times the median."""
-    m = np.median(k)
+    """The engine's clamp: k within [low, high] times the median (of the finite ones: a cospherical array has
+    many flat pores, L = 0)."""
+    m = np.median(k[np.isfinite(k)])
     return np.clip(k, low * m, high * m)
+
+
+# The table's rows: (label, mu k of (throats, geometry)).
+TABLE = [
+    ("thesis", thesis),
+    ("constriction", constriction),
+    ("facet_radius", facet_radius),
+    ("entrance, beta = 3 pi / 8", entrance),
+    ("entrance, beta = 1", lambda t, g: entrance(t, g, beta=1.0)),
+    ("orifice, gamma = 2", lambda t, g: orifice(t, g, gamma=2.0)),
+    ("thesis x (1 - A_f / A)", lambda t, g: thesis(t, g) * (1.0 - g["fluid_area"] / g["area"])),
+    ("thesis x (1 - A_f / A)^1.5", lambda t, g: thesis(t, g) * (1.0 - g["fluid_area"] / g["area"]) ** 1.5),
+    ("entrance, beta = 0.2, x (1 - A_f / A)", lambda t, g: entrance(t, g, 0.2) * (1.0 - g["fluid_area"] / g["area"])),
+]
+# Regular arrays: (array, c) with the periodic reference's mesh limit (periodic_run's stored rows); the touching
+# simple cubic array against Zick & Homsy's K = 42.1.
+ARRAYS = [("sc", 0.45), ("bcc", 0.45), ("bcc", 0.6), ("fcc", 0.45), ("fcc", 0.6)]
+TILES = 3  # the engine wants a cell a few diameters thick: the arrays' cube is tiled 3 x 3 x 3
+
+
+def _tiled(packing):
+    shifts = np.array(list(itertools.product(range(TILES), repeat=3)), dtype=float)
+    centres = (np.asarray(packing["centres"])[None, :, :] + shifts[:, None, :]).reshape(-1, 3) / TILES
+    # moved off the faces (a translation changes nothing in a periodic cell)
+    return {
+        "centres": np.mod(centres + 0.1 / TILES, 1.0),
+        "radii": np.full(len(centres), packing["radius_unshrunk"] / TILES),
+        "cell": [1.0, 1.0, 1.0],
+    }
+
+
+def regular_cases():
+    """(name, PFV run, geometry, kappa_ref) of the regular arrays, kappa in the tiled cell's units."""
+    make = {"sc": periodic_mesh.simple_cubic, "bcc": periodic_mesh.body_centred, "fcc": periodic_mesh.face_centred}
+    rows = periodic_run.load(periodic_run.RESULTS)
+    series = periodic_run.series(rows)
+    out = []
+    for array, c in ARRAYS:
+        kappa = (
+            2.0 * make[array](c)["radius_unshrunk"] ** 2 / (9.0 * c * periodic_run.limit(series[(array, c, 0.0)])[0])
+        )
+        out.append((array, c, kappa))
+    touching = periodic_run.TOUCHING_SC
+    out.append(("sc", touching, 2.0 * 0.25 / (9.0 * touching * periodic_run.ZICK_HOMSY_SC[0.5236])))
+    cases = []
+    for array, c, kappa in out:
+        packing = _tiled(make[array](c))
+        model = pfv_periodic.run(packing)
+        cases.append(("%s %.2f" % (array, c), model, throat_study.features(model, packing), kappa / TILES**2))
+    return cases
+
+
+def random_cases(paths):
+    """(name, PFV run, geometry, kappa_FEM on the finest mesh) of the stored random packings."""
+    rows = [r for path in paths for r in periodic_random.load(path)]
+    cases = []
+    for (name, shrink), row in throat_study.cases(rows).items():
+        d = throat_study.throat_data(row)
+        label = name + ("@%g" % shrink if shrink else "")
+        cases.append((label, d["model"], d["geometry"], row["kappa"]))
+    return cases
+
+
+def table(cases):
+    """Markdown: kappa / kappa_ref of every candidate on every case, and the largest |log| of the ratios."""
+    lines = [
+        "| candidate | %s | max \\|ln ratio\\| |" % " | ".join(name for name, _, _, _ in cases),
+        "|---|%s---|" % ("---|" * len(cases)),
+    ]
+    for label, fn in TABLE:
+        ratios = []
+        for _, model, geometry, kappa in cases:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                k = clamped(fn(model["throats"], geometry))
+            ratios.append(pfv_periodic.network_kappa(model["throats"], k, model["n_cells"])[0] / kappa)
+        lines.append(
+            "| %s | %s | %.3f |"
+            % (label, " | ".join("%.3f" % r for r in ratios), np.abs(np.log(np.array(ratios))).max())
+        )
+    return "\n".join(lines)
+
+
+def main():
+    paths = [periodic_random.RESULTS, periodic_random.SMALL_RESULTS]
+    print(table(regular_cases() + random_cases(paths)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -14,6 +14,10 @@ import numpy as np
 from dolfinx import geometry
 from scipy.spatial import cKDTree
 
+# Sub-triangles per element size along a triangle's longest edge. 3 and 6 gave the CI case's mean velocity from
+# its throat fluxes alike to 2e-5 (both 0.67 % from the FEM's volume mean, the discrete field's own error, which
+# shrinks with the mesh: 0.2 % at h = 0.07 on a 12-sphere cell) and its pore imbalance to 1e-5.
+SUBDIVISION = 3.0
 # Rule of degree 2 on a triangle: barycentric points and equal weights (1/3 each, times the area).
 _RULE = np.array([[2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
 
@@ -115,7 +119,7 @@ def fluxes(mesh, u, triangles, normals, centres, radii, cell, element_size, chun
     triangles = np.asarray(triangles, dtype=float)
     out = np.zeros(len(triangles))
     edges = np.linalg.norm(triangles - np.roll(triangles, 1, axis=1), axis=2).max(1)
-    subdivisions = np.maximum(2, np.ceil(3.0 * edges / element_size).astype(int))
+    subdivisions = np.maximum(2, np.ceil(SUBDIVISION * edges / element_size).astype(int))
     missing = 0
     batch, owners, weights = [], [], []
 

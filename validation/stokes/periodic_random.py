@@ -23,14 +23,17 @@ import numpy as np
 from . import facet_flux, periodic_mesh, periodic_packings, periodic_solve, pfv_periodic
 from .mesh import tangled_cells
 from .packings import shrunk
-from .report import MIN_SHRINK_ORDER, richardson
+from .report import MIN_SHRINK_ORDER, check_stored, richardson
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "data", "periodic_random.json")
+SMALL_RESULTS = os.path.join(HERE, "data", "periodic_small.json")  # the 16-sphere cells
 LEVELS = (0.045, 0.034, 0.025)
 SHRINKS = (0.01, 0.005, 0.0025)
 # Elements across a gap between two spheres (periodic_mesh's gap_elements): unfolded meshes at the contacts
 GAP_ELEMENTS = 1.0
+QUICK = {"packing": "small_mono_c40_s11", "surface": 0.1}
+QUICK_REFERENCE = os.path.join(os.path.dirname(os.path.dirname(HERE)), "tests", "data", "stokes_random_quick.json")
 
 
 def shrinks_of(packing):
@@ -78,6 +81,43 @@ def run_one(name, shrink, surface, solver="auto"):
         "pore_pressure_pfv": model["pressure"].tolist(),
         **r,
     }
+
+
+def quick_numbers():
+    """The CI case: QUICK's packing on one coarse mesh, kappa and its throats."""
+    row = run_one(QUICK["packing"], 0.0, QUICK["surface"])
+    packing = periodic_packings.load(QUICK["packing"])
+    model = pfv_periodic.run(packing)
+    t = model["throats"]
+    branch = t["power_centre_1"] - t["power_centre_0"]
+    u = np.asarray(row["throat_flux_fem"]) @ branch  # (1 / V) sum q d, V = 1
+    keys = ("kappa", "kappa_pfv", "dofs", "cells", "folded_cells", "throat_imbalance", "throat_points_missed")
+    out = {key: row[key] for key in keys}
+    out["kappa_from_throats"] = float(u[0])
+    out["packing_c"] = float(4.0 / 3.0 * np.pi * (packing["radii"] ** 3).sum())
+    out["packing_min_gap"] = periodic_packings.min_gap(packing)
+    return out
+
+
+def compare_quick(now, ref):
+    """Rows (what, value, expected, ok): the mesh and kappa as stored (DOFs exactly, kappa to 1e-6, PFV's
+    kappa to 1e-9), the throat fluxes' mean velocity within 1 % of the FEM's (0.2-0.5 % measured), the fluxes out
+    of each pore balanced to 1 % (their quadrature error), no fold, the packing's solid fraction and gap."""
+    return [
+        ("DOFs", now["dofs"], ref["dofs"], now["dofs"] == ref["dofs"]),
+        ("kappa FEM", now["kappa"], ref["kappa"], abs(now["kappa"] / ref["kappa"] - 1) < 1e-6),
+        ("kappa PFV", now["kappa_pfv"], ref["kappa_pfv"], abs(now["kappa_pfv"] / ref["kappa_pfv"] - 1) < 1e-9),
+        (
+            "kappa from the throat fluxes / kappa - 1",
+            now["kappa_from_throats"] / now["kappa"] - 1,
+            0.01,
+            abs(now["kappa_from_throats"] / now["kappa"] - 1) < 0.01,
+        ),
+        ("pore flux imbalance", now["throat_imbalance"], 0.01, now["throat_imbalance"] < 0.01),
+        ("folded cells", now["folded_cells"], 0, now["folded_cells"] <= 1e-3 * now["cells"]),
+        ("packing solid fraction", now["packing_c"], 0.4, abs(now["packing_c"] - 0.4) < 1e-6),
+        ("packing min gap / (r_i + r_j)", now["packing_min_gap"], 0.03, now["packing_min_gap"] > 0.03 - 1e-6),
+    ]
 
 
 def key_of(row):
@@ -171,7 +211,11 @@ def main():
     ap.add_argument("--solver", choices=("auto", "direct", "minres"), default="auto")
     ap.add_argument("--out", default=RESULTS)
     ap.add_argument("--report", action="store_true")
+    ap.add_argument("--quick", action="store_true", help="the CI case against " + QUICK_REFERENCE)
+    ap.add_argument("--write-reference", action="store_true")
     args = ap.parse_args()
+    if args.quick:
+        return check_stored(quick_numbers(), QUICK_REFERENCE, compare_quick, args.write_reference)
     levels = [float(x) for x in args.levels.split(",")]
     rows = load(args.out) if args.report else run_cases(args.packings.split(","), levels, args.out, args.solver)
     print(report(rows))

@@ -23,7 +23,7 @@ import numpy as np
 from . import facet_flux, periodic_mesh, periodic_packings, periodic_solve, pfv_periodic
 from .mesh import tangled_cells
 from .packings import shrunk
-from .report import MIN_SHRINK_ORDER, check_stored, richardson
+from .report import check_stored, richardson
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "data", "periodic_random.json")
@@ -168,39 +168,42 @@ def save(rows, path):
         json.dump(rows, f)
 
 
-def limits(rows):
-    """{packing: {shrink: (kappa at h -> 0, order, kappa_pfv)}} from the rows (Richardson through the last three
-    levels; with two, the finest level and nan)."""
+def report(rows):
+    """Markdown, one row per packing and shrink: kappa_FEM at every element size, the finest level's change from
+    the one before, its Richardson limit where three levels exist, and PFV's kappa over the finest (or the
+    limit)."""
     by = {}
     for r in rows:
-        by.setdefault(r["packing"], {}).setdefault(r["shrink"], []).append(r)
-    out = {}
-    for name, shrinks in by.items():
-        for shrink, levels in shrinks.items():
-            levels.sort(key=lambda r: -r["surface"])
-            if len(levels) >= 3:
-                k, q = richardson([r["surface"] for r in levels[-3:]], [r["kappa"] for r in levels[-3:]])
-            else:
-                k, q = levels[-1]["kappa"], float("nan")
-            out.setdefault(name, {})[shrink] = (k, q, levels[-1]["kappa_pfv"])
-    return out
-
-
-def touching(values):
-    """kappa at zero shrink from {shrink: kappa} (Richardson in the shrink), with its spread (the distance of the
-    limit from the straight line through the two smallest shrinks)."""
-    s = sorted(values, reverse=True)
-    k = [values[x] for x in s]
-    limit, order = richardson(s, k, MIN_SHRINK_ORDER)
-    line = k[-1] - (k[-2] - k[-1]) * s[-1] / (s[-2] - s[-1])
-    return limit, order, abs(line / limit - 1)
-
-
-def report(rows):
-    lines = ["| packing | shrink | κ_FEM (h → 0) | order | κ_PFV / κ_FEM |", "|---|---|---|---|---|"]
-    for name, shrinks in limits(rows).items():
-        for shrink, (k, q, k_pfv) in sorted(shrinks.items(), reverse=True):
-            lines.append("| %s | %g | %.5e | %.1f | %.3f |" % (name, shrink, k, q, k_pfv / k))
+        by.setdefault((r["packing"], r["shrink"]), []).append(r)
+    lines = [
+        "| packing | spheres | c | shrink | κ_FEM at h = … | last change | κ_FEM (h → 0) | DOFs, finest "
+        "| κ_PFV / κ_FEM |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for (name, shrink), levels in by.items():
+        levels.sort(key=lambda r: -r["surface"])
+        packing = periodic_packings.load(name)
+        change = levels[-1]["kappa"] / levels[-2]["kappa"] - 1 if len(levels) > 1 else float("nan")
+        limit = (
+            richardson([r["surface"] for r in levels[-3:]], [r["kappa"] for r in levels[-3:]])[0]
+            if len(levels) >= 3
+            else float("nan")
+        )
+        best = limit if np.isfinite(limit) else levels[-1]["kappa"]
+        lines.append(
+            "| %s | %d | %.2f | %g | %s | %s | %s | %d | %.3f |"
+            % (
+                name,
+                len(packing["radii"]),
+                packing["c"],
+                shrink,
+                ", ".join("%.4e (%g)" % (r["kappa"], r["surface"]) for r in levels),
+                "%+.2f %%" % (100 * change) if np.isfinite(change) else "",
+                "%.4e" % limit if np.isfinite(limit) else "",
+                levels[-1]["dofs"],
+                levels[-1]["kappa_pfv"] / best,
+            )
+        )
     return "\n".join(lines)
 
 

@@ -1,7 +1,7 @@
 """Where the hydraulic-radius conductance goes wrong: PFV's throats against the periodic Stokes reference.
 
     export PYTHONPATH=$BUILD/python
-    /usr/bin/python3 -m validation.stokes.throat_study [--results=FILE]
+    /usr/bin/python3 -m validation.stokes.throat_study [--results=FILE,...] [--figure=PNG]
 
 For every packing and shrink of periodic_random.py's results (its finest mesh), PFV's triangulation of the same
 spheres is rebuilt (it is a function of the spheres) and every throat gets:
@@ -133,11 +133,48 @@ def summary(rows):
     return "\n".join(lines)
 
 
+def figure(rows, path):
+    """Per throat, k_PFV / k_FEM against the facet's open fraction A_f / A and against min(L_0, L_1) / L, every
+    case of the results, markers sized by the throat's share of the flux."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    for (name, shrink), row in cases(rows).items():
+        d = throat_data(row)
+        g, t = d["geometry"], d["model"]["throats"]
+        drop = np.abs(d["drop_fem"])
+        ok = drop > MIN_DROP * drop.mean()
+        ratio = t["conductance"][ok] / (d["q_fem"][ok] / d["drop_fem"][ok])
+        size = 2000.0 * np.abs(d["q_fem"][ok]) / np.abs(d["q_fem"]).sum()
+        label = "%s (%d spheres)" % (name, row["n_spheres"])
+        axes[0].scatter((g["fluid_area"] / g["area"])[ok], ratio, s=size, alpha=0.35, label=label)
+        axes[1].scatter((np.minimum(g["l0"], g["l1"]) / g["length"])[ok], ratio, s=size, alpha=0.35)
+    for ax, xlabel in zip(
+        axes, ("A_f / A (open fraction of the facet)", "min(L_0, L_1) / L (< 0: power centre beyond")
+    ):
+        ax.set_xlabel(xlabel + (" the facet)" if "L_0" in xlabel else ""))
+        ax.axhline(1.0, color="k", lw=0.8)
+        ax.set_yscale("log")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[1].set_xlim(-1.5, 0.55)
+    axes[0].set_ylabel("k_PFV / k_FEM  (k_FEM = q_FEM / dp_FEM)")
+    axes[0].legend(fontsize=7, markerscale=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--results", default=periodic_random.RESULTS)
+    ap.add_argument("--results", default=periodic_random.RESULTS + "," + periodic_random.SMALL_RESULTS)
+    ap.add_argument("--figure", help="also draw the per-throat figure into this PNG")
     args = ap.parse_args()
-    print(summary(periodic_random.load(args.results)))
+    rows = [r for path in args.results.split(",") for r in periodic_random.load(path)]
+    print(summary(rows))
+    if args.figure:
+        figure(rows, args.figure)
     return 0
 
 

@@ -94,6 +94,14 @@ def quick_numbers():
     keys = ("kappa", "kappa_pfv", "dofs", "cells", "folded_cells", "throat_imbalance", "throat_points_missed")
     out = {key: row[key] for key in keys}
     out["kappa_from_throats"] = float(u[0])
+    # PFV's own throat fluxes give its mean velocity exactly (the engine's definition of U)
+    out["kappa_pfv_from_throats"] = float((t["flux"] @ branch)[0])
+    # every pair of spheres has a gap, so every throat has an open constriction (r_c > 0), no larger than the
+    # spheres are apart
+    r_c = t["constriction_radius"]
+    edges = np.linalg.norm(t["triangle"] - np.roll(t["triangle"], 1, axis=1), axis=2).max(1)
+    out["constriction_min_over_radius"] = float((r_c / t["radii"].mean(1)).min())
+    out["constriction_max_over_edge"] = float((r_c / edges).max())
     out["packing_c"] = float(4.0 / 3.0 * np.pi * (packing["radii"] ** 3).sum())
     out["packing_min_gap"] = periodic_packings.min_gap(packing)
     return out
@@ -114,6 +122,19 @@ def compare_quick(now, ref):
             abs(now["kappa_from_throats"] / now["kappa"] - 1) < 0.01,
         ),
         ("pore flux imbalance", now["throat_imbalance"], 0.01, now["throat_imbalance"] < 0.01),
+        (
+            "PFV: kappa from its throat fluxes / kappa - 1",
+            now["kappa_pfv_from_throats"] / now["kappa_pfv"] - 1,
+            1e-12,
+            abs(now["kappa_pfv_from_throats"] / now["kappa_pfv"] - 1) < 1e-12,
+        ),
+        (
+            "min r_c / mean radius over the throats",
+            now["constriction_min_over_radius"],
+            0.0,
+            now["constriction_min_over_radius"] > 0.0,
+        ),
+        ("max r_c / longest edge", now["constriction_max_over_edge"], 1.0, now["constriction_max_over_edge"] < 1.0),
         ("folded cells", now["folded_cells"], 0, now["folded_cells"] <= 1e-3 * now["cells"]),
         ("packing solid fraction", now["packing_c"], 0.4, abs(now["packing_c"] - 0.4) < 1e-6),
         ("packing min gap / (r_i + r_j)", now["packing_min_gap"], 0.03, now["packing_min_gap"] > 0.03 - 1e-6),

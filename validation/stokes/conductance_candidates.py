@@ -14,7 +14,7 @@ import warnings
 
 import numpy as np
 
-from . import periodic_mesh, periodic_random, periodic_run, pfv_periodic, throat_study
+from . import periodic_mesh, periodic_packings, periodic_random, periodic_run, pfv_periodic, throat_study
 
 
 def facet_perimeter(throats):
@@ -137,6 +137,10 @@ def random_cases(paths):
         d = throat_study.throat_data(row)
         label = name + ("@%g" % shrink if shrink else "")
         cases.append((label, d["model"], d["geometry"], row["kappa"]))
+    for name, (limit, _, _) in periodic_random.touching(rows).items():
+        packing = periodic_packings.load(name)
+        model = pfv_periodic.run(packing)
+        cases.append((name + " touching", model, throat_study.features(model, packing), limit))
     return cases
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from . import facet_flux, periodic_mesh, periodic_packings, periodic_solve, pfv_periodic
 from .mesh import tangled_cells
 from .packings import shrunk
-from .report import check_stored, richardson
+from .report import MIN_SHRINK_ORDER, check_stored, richardson
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "data", "periodic_random.json")
@@ -189,6 +189,32 @@ def save(rows, path):
         json.dump(rows, f)
 
 
+def finest(rows):
+    """{(packing, shrink): the row of its finest mesh}."""
+    out = {}
+    for r in rows:
+        key = (r["packing"], r["shrink"])
+        if key not in out or r["surface"] < out[key]["surface"]:
+            out[key] = r
+    return out
+
+
+def touching(rows):
+    """{packing: (kappa at zero shrink, observed order, spread)} for the packings with contacts computed at every
+    shrink of SHRINKS, from each shrink's finest mesh: Richardson in the shrink as doc/validation.md section 7, the
+    spread being the limit's distance from the straight line through the two smallest shrinks."""
+    best = finest(rows)
+    out = {}
+    for name in sorted({n for n, s in best if s > 0}):
+        if not all((name, s) in best for s in SHRINKS):
+            continue
+        k = [best[(name, s)]["kappa"] for s in SHRINKS]
+        limit, order = richardson(list(SHRINKS), k, MIN_SHRINK_ORDER)
+        line = k[-1] - (k[-2] - k[-1]) * SHRINKS[-1] / (SHRINKS[-2] - SHRINKS[-1])
+        out[name] = (limit, order, abs(line / limit - 1))
+    return out
+
+
 def report(rows):
     """Markdown, one row per packing and shrink: kappa_FEM at every element size, the finest level's change from
     the one before, its Richardson limit where three levels exist, and PFV's kappa over the finest (or the
@@ -224,6 +250,13 @@ def report(rows):
                 levels[-1]["dofs"],
                 levels[-1]["kappa_pfv"] / best,
             )
+        )
+    for name, (limit, order, spread) in touching(rows).items():
+        packing = periodic_packings.load(name)
+        kappa_pfv = pfv_periodic.run(packing)["kappa"]  # on the touching spheres themselves
+        lines.append(
+            "| %s | %d | %.2f | → 0 | touching: q = %.2f, ± %.2f %% | | %.4e | | %.3f |"
+            % (name, len(packing["radii"]), packing["c"], order, 100 * spread, limit, kappa_pfv / limit)
         )
     return "\n".join(lines)
 

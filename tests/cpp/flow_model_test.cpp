@@ -28,6 +28,24 @@ TEST(Conductance, PoiseuilleForACircularTube) {
   EXPECT_NEAR(throat_conductances(f, m)[0], M_PI * std::pow(r, 4) / (8 * mu * L), 1e-15);
 }
 
+TEST(Conductance, DagansTubeWithTheEntranceTerm) {
+  // With the orifice in series (entrance = 3 pi / 8), the same tube conducts Dagan, Weinberg &
+  // Tamir's pi r^4 / (8 mu (L + 3 pi r / 8)); a flat throat (L = 0) keeps a finite conductance.
+  FacetGeometry f;
+  const double r = 0.3, mu = 2.5, L = 1.7;
+  f.cell = {{0, 1}, {0, 1}};
+  f.fluid_area = {M_PI * r * r, M_PI * r * r};
+  f.hydraulic_radius = {r / 2, r / 2};
+  f.length = {L, 0.0};
+  ConductanceModel m;
+  m.viscosity = mu;
+  m.clamp = false;
+  m.entrance = 3 * M_PI / 8;
+  const auto k = throat_conductances(f, m);
+  EXPECT_NEAR(k[0], M_PI * std::pow(r, 4) / (8 * mu * (L + 3 * M_PI * r / 8)), 1e-15);
+  EXPECT_NEAR(k[1], std::pow(r, 3) / (3 * mu), 1e-15);  // Sampson's orifice alone
+}
+
 TEST(FlowModel, CholmodMatchesDenseSolve) {
   const auto p = test::random_packing(200, 21);
   FlowEngine e = permeameter(1);

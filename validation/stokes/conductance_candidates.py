@@ -8,7 +8,6 @@ conductance times the viscosity (a volume): no per-packing input. The network wi
 pfv_periodic.network_kappa, the same periodic system as the engine's, so a candidate is tried without rebuilding
 the engine.
 """
-import itertools
 import sys
 import warnings
 
@@ -94,22 +93,11 @@ TABLE = [
 # Regular arrays: (array, c) with the periodic reference's mesh limit (periodic_run's stored rows); the touching
 # simple cubic array against Zick & Homsy's K = 42.1.
 ARRAYS = [("sc", 0.45), ("bcc", 0.45), ("bcc", 0.6), ("fcc", 0.45), ("fcc", 0.6)]
-TILES = 3  # the engine wants a cell a few diameters thick: the arrays' cube is tiled 3 x 3 x 3
-
-
-def _tiled(packing):
-    shifts = np.array(list(itertools.product(range(TILES), repeat=3)), dtype=float)
-    centres = (np.asarray(packing["centres"])[None, :, :] + shifts[:, None, :]).reshape(-1, 3) / TILES
-    # moved off the faces (a translation changes nothing in a periodic cell)
-    return {
-        "centres": np.mod(centres + 0.1 / TILES, 1.0),
-        "radii": np.full(len(centres), packing["radius_unshrunk"] / TILES),
-        "cell": [1.0, 1.0, 1.0],
-    }
 
 
 def regular_cases():
-    """(name, PFV run, geometry, kappa_ref) of the regular arrays, kappa in the tiled cell's units."""
+    """(name, PFV run, geometry, kappa_ref) of the regular arrays (the unit cube of the lattice, which
+    pfv_periodic.run tiles)."""
     make = {"sc": periodic_mesh.simple_cubic, "bcc": periodic_mesh.body_centred, "fcc": periodic_mesh.face_centred}
     rows = periodic_run.load(periodic_run.RESULTS)
     series = periodic_run.series(rows)
@@ -123,9 +111,9 @@ def regular_cases():
     out.append(("sc", touching, 2.0 * 0.25 / (9.0 * touching * periodic_run.ZICK_HOMSY_SC[0.5236])))
     cases = []
     for array, c, kappa in out:
-        packing = _tiled(make[array](c))
+        packing = make[array](c)
         model = pfv_periodic.run(packing)
-        cases.append(("%s %.2f" % (array, c), model, throat_study.features(model, packing), kappa / TILES**2))
+        cases.append(("%s %.2f" % (array, c), model, throat_study.features(model, packing), kappa))
     return cases
 
 
@@ -156,7 +144,7 @@ def table(cases):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 k = clamped(fn(model["throats"], geometry))
-            ratios.append(pfv_periodic.network_kappa(model["throats"], k, model["n_cells"])[0] / kappa)
+            ratios.append(pfv_periodic.network_kappa(model["throats"], k, model["n_cells"], model["volume"])[0] / kappa)
         lines.append(
             "| %s | %s | %.3f |"
             % (label, " | ".join("%.3f" % r for r in ratios), np.abs(np.log(np.array(ratios))).max())

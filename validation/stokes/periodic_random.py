@@ -90,12 +90,12 @@ def quick_numbers():
     model = pfv_periodic.run(packing)
     t = model["throats"]
     branch = t["power_centre_1"] - t["power_centre_0"]
-    u = np.asarray(row["throat_flux_fem"]) @ branch  # (1 / V) sum q d, V = 1
+    u = np.asarray(row["throat_flux_fem"]) @ branch / model["volume"]  # (1 / V) sum q d
     keys = ("kappa", "kappa_pfv", "dofs", "cells", "folded_cells", "throat_imbalance", "throat_points_missed")
     out = {key: row[key] for key in keys}
     out["kappa_from_throats"] = float(u[0])
     # PFV's own throat fluxes give its mean velocity exactly (the engine's definition of U)
-    out["kappa_pfv_from_throats"] = float((t["flux"] @ branch)[0])
+    out["kappa_pfv_from_throats"] = float((t["flux"] @ branch)[0] / model["volume"])
     # every pair of spheres has a gap, so every throat has an open constriction (r_c > 0), no larger than the
     # spheres are apart
     r_c = t["constriction_radius"]

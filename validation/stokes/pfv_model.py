@@ -13,11 +13,12 @@ FACES = ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax")
 VARIANTS = ("noslip", "slip", "slip_yade")
 
 
-def run(packing, variant, dp=1.0, mu=1.0):
+def run(packing, variant, dp=1.0, mu=1.0, entrance=0.0):
     centres = np.ascontiguousarray(packing["centres"], dtype=float)
     radii = np.ascontiguousarray(packing["radii"], dtype=float)
     e = pfv.Engine()
     e.viscosity = mu
+    e.conductance_entrance = entrance
     e.slip_boundary = variant != "noslip"
     e.yade_wall_throat_factor = variant == "slip_yade"
     e.bnd_is_pressure = [False, False, True, True, False, False]

@@ -6,24 +6,38 @@ infinite periodic packing, each with its geometry (pfv._core.PeriodicFlow.throat
 Stokes reference, its triangle: the three sphere centres as seen from the pore on side 0, and the two power
 centres (side 1 translated into that frame).
 """
+import itertools
+
 import numpy as np
 
 from pfv import _core
 
 
+def tiled(packing):
+    """(centres, radii, cell side lengths) of the packing repeated n times along each axis, n the smallest count
+    that makes the cell two diameters of its largest sphere thick (the engine's minimum; a cell of 16 unequal
+    spheres can be thinner). The tiled cell holds the same infinite periodic packing: same pores, same kappa."""
+    side = np.asarray(packing.get("cell", (1.0, 1.0, 1.0)), dtype=float)
+    centres, radii = np.asarray(packing["centres"], dtype=float), np.asarray(packing["radii"], dtype=float)
+    n = int(np.ceil(4.0 * radii.max() / side.min() * (1.0 + 1e-9)))
+    shifts = np.array(list(itertools.product(range(n), repeat=3)), dtype=float) * side
+    return (centres[None, :, :] + shifts[:, None, :]).reshape(-1, 3), np.tile(radii, n**3), side * n
+
+
 def run(packing, direction=(1.0, 0.0, 0.0)):
-    """{kappa, U, n_cells, throats: dict of per-facet arrays} of PFV on the packing (centres, radii, cell)."""
-    cell = np.diag(np.asarray(packing.get("cell", (1.0, 1.0, 1.0)), dtype=float))
+    """{kappa, U, n_cells, volume, throats: dict of per-facet arrays} of PFV on the packing (centres, radii, cell),
+    tiled where the engine needs a thicker cell (tiled)."""
+    centres, radii, side = tiled(packing)
     direction = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
     flow = _core.PeriodicFlow()
     flow.set_settings(viscosity=1.0, permeability_factor=1.0, gradient=-direction, bulk_modulus=0.0)
-    flow.step(np.asarray(packing["centres"], dtype=float), np.asarray(packing["radii"], dtype=float), cell, 1.0)
+    flow.step(centres, radii, np.diag(side), 1.0)
     u = np.asarray(flow.mean_velocity())
     t = flow.throats()
     images = np.asarray(flow.image_positions())
     centres = np.asarray(flow.power_centres())
     t["triangle"] = images[t["vertices"]]  # (m, 3 vertices, 3)
-    t["radii"] = np.asarray(packing["radii"], dtype=float)[np.asarray(flow.image_spheres())[t["vertices"]]]
+    t["radii"] = radii[np.asarray(flow.image_spheres())[t["vertices"]]]
     t["power_centre_0"] = centres[t["cells"][:, 0]]
     t["power_centre_1"] = centres[t["cells"][:, 1]] + t["translation"]
     t["cell_vertices"] = images[np.asarray(flow.cell_vertices())][t["cells"][:, 0]]  # side 0's tetrahedron
@@ -34,6 +48,7 @@ def run(packing, direction=(1.0, 0.0, 0.0)):
         "kappa": float(u @ direction),
         "U": u.tolist(),
         "n_cells": int(flow.n_cells),
+        "volume": float(np.prod(side)),
         "power_centres": centres,
         "pressure": np.asarray(flow.pressure()),
         "throats": t,

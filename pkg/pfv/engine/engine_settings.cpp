@@ -30,6 +30,7 @@ void validate(const EngineSettings& s) {
   require(finite_positive(c.permeability_factor),
           named("permeabilityFactor", c.permeability_factor,
                 "positive and finite (the negative 'homogeneous' variant is not supported)"));
+  require(std::isfinite(c.entrance) && c.entrance >= 0, named("conductance_entrance", c.entrance, "finite and >= 0"));
   // Checked even while clamping is off: switching it on must not reveal a bad value later.
   require(finite_positive(c.min_ratio), named("minKdivKmean", c.min_ratio, "positive and finite"));
   require(finite_positive(c.max_ratio) && c.max_ratio >= c.min_ratio,

@@ -32,9 +32,9 @@ std::vector<std::pair<int, double>> apply_yade_wall_throat_factor(const Mesh& me
 bool MeshRecipe::stale_for(const EngineSettings& s) const {
   const ConductanceModel& a = conductance;
   const ConductanceModel& b = s.conductance;
-  return a.permeability_factor != b.permeability_factor || a.clamp != b.clamp || a.min_ratio != b.min_ratio ||
-         a.max_ratio != b.max_ratio || slip_boundary != s.slip_boundary || (s.viscous_shear && !viscous_shear) ||
-         yade_wall_throat_factor != s.yade_wall_throat_factor;
+  return a.permeability_factor != b.permeability_factor || a.entrance != b.entrance || a.clamp != b.clamp ||
+         a.min_ratio != b.min_ratio || a.max_ratio != b.max_ratio || slip_boundary != s.slip_boundary ||
+         (s.viscous_shear && !viscous_shear) || yade_wall_throat_factor != s.yade_wall_throat_factor;
 }
 
 void PoreMesh::set_viscosity(double mu) {

@@ -15,7 +15,8 @@ std::vector<double> throat_conductances(const FacetGeometry& f, const Conductanc
     if (f.cell[i][1] < 0) continue;
     const double rh = f.hydraulic_radius[i];
     const double g = alpha * f.fluid_area[i] * rh * rh / m.viscosity;
-    k[i] = f.length[i] > 0 ? g / f.length[i] : HUGE_VAL;
+    const double length = f.length[i] + (m.entrance > 0 ? m.entrance * std::sqrt(f.fluid_area[i] / M_PI) : 0.0);
+    k[i] = length > 0 ? g / length : HUGE_VAL;
     if (std::isfinite(k[i])) finite.push_back(k[i]);
   }
   if (!m.clamp) {

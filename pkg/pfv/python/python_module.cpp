@@ -163,6 +163,8 @@ PYBIND11_MODULE(_core, m) {
       .def_property("permeability_factor", get_setting(&ConductanceModel::permeability_factor),
                     set_setting(&ConductanceModel::permeability_factor))
       .def_property("clamp_k_values", get_setting(&ConductanceModel::clamp), set_setting(&ConductanceModel::clamp))
+      .def_property("conductance_entrance", get_setting(&ConductanceModel::entrance),
+                    set_setting(&ConductanceModel::entrance))
       .def_property("min_k_div_k_mean", get_setting(&ConductanceModel::min_ratio),
                     set_setting(&ConductanceModel::min_ratio))
       .def_property("max_k_div_k_mean", get_setting(&ConductanceModel::max_ratio),

@@ -44,6 +44,7 @@ const std::map<std::string, std::function<void(FlowEngine&)>>& edits() {
   static const std::map<std::string, std::function<void(FlowEngine&)>> table{
       {"permeability_factor", [](FlowEngine& e) { e.settings.conductance.permeability_factor = 2.0; }},
       {"clamp_k_values", [](FlowEngine& e) { e.settings.conductance.clamp = false; }},
+      {"conductance_entrance", [](FlowEngine& e) { e.settings.conductance.entrance = 1.0; }},
       {"min_k_div_k_mean", [](FlowEngine& e) { e.settings.conductance.min_ratio = 1e-3; }},
       {"max_k_div_k_mean", [](FlowEngine& e) { e.settings.conductance.max_ratio = 50.0; }},
       {"slip_boundary", [](FlowEngine& e) { e.settings.slip_boundary = false; }},

@@ -78,17 +78,25 @@ def clamped(k, low=1e-4, high=100.0):
     return np.clip(k, low * m, high * m)
 
 
-# The table's rows: (label, mu k of (throats, geometry)).
+# The candidates: (short name, description, mu k of (throats, geometry)); phi = A_f / A.
 TABLE = [
-    ("thesis", thesis),
-    ("constriction", constriction),
-    ("facet_radius", facet_radius),
-    ("entrance, beta = 3 pi / 8", entrance),
-    ("entrance, beta = 1", lambda t, g: entrance(t, g, beta=1.0)),
-    ("orifice, gamma = 2", lambda t, g: orifice(t, g, gamma=2.0)),
-    ("thesis x (1 - A_f / A)", lambda t, g: thesis(t, g) * (1.0 - g["fluid_area"] / g["area"])),
-    ("thesis x (1 - A_f / A)^1.5", lambda t, g: thesis(t, g) * (1.0 - g["fluid_area"] / g["area"]) ** 1.5),
-    ("entrance, beta = 0.2, x (1 - A_f / A)", lambda t, g: entrance(t, g, 0.2) * (1.0 - g["fluid_area"] / g["area"])),
+    ("thesis", "the thesis' A_f R_h^2 / (2 L)", thesis),
+    ("r_c", "Poiseuille through the constriction", constriction),
+    ("A_f/P", "the thesis' form with the facet's own hydraulic radius", facet_radius),
+    ("Dagan", "entrance, beta = 3 pi / 8 (Dagan's)", entrance),
+    ("β = 1", "entrance, beta = 1", lambda t, g: entrance(t, g, beta=1.0)),
+    ("γ = 2", "orifice, gamma = 2", lambda t, g: orifice(t, g, gamma=2.0)),
+    ("(1 − φ)", "thesis x (1 - A_f / A)", lambda t, g: thesis(t, g) * (1.0 - g["fluid_area"] / g["area"])),
+    (
+        "(1 − φ)^1.5",
+        "thesis x (1 - A_f / A)^1.5",
+        lambda t, g: thesis(t, g) * (1.0 - g["fluid_area"] / g["area"]) ** 1.5,
+    ),
+    (
+        "β = 0.2, (1 − φ)",
+        "entrance, beta = 0.2, x (1 - A_f / A)",
+        lambda t, g: entrance(t, g, 0.2) * (1.0 - g["fluid_area"] / g["area"]),
+    ),
 ]
 # Regular arrays: (array, c) with the periodic reference's mesh limit (periodic_run's stored rows); the touching
 # simple cubic array against Zick & Homsy's K = 42.1.
@@ -132,29 +140,54 @@ def random_cases(paths):
     return cases
 
 
-def table(cases):
-    """Markdown: kappa / kappa_ref of every candidate on every case, and the largest |log| of the ratios."""
-    lines = [
-        "| candidate | %s | max \\|ln ratio\\| |" % " | ".join(name for name, _, _, _ in cases),
-        "|---|%s---|" % ("---|" * len(cases)),
-    ]
-    for label, fn in TABLE:
-        ratios = []
+def ratios(cases):
+    """{candidate: [kappa / kappa_ref per case]}."""
+    out = {}
+    for name, _, fn in TABLE:
         for _, model, geometry, kappa in cases:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 k = clamped(fn(model["throats"], geometry))
-            ratios.append(pfv_periodic.network_kappa(model["throats"], k, model["n_cells"], model["volume"])[0] / kappa)
+            value = pfv_periodic.network_kappa(model["throats"], k, model["n_cells"], model["volume"])[0] / kappa
+            out.setdefault(name, []).append(value)
+    return out
+
+
+def table(cases, values):
+    """Markdown: kappa / kappa_ref, one row per case, one column per candidate."""
+    lines = ["| case | %s |" % " | ".join(name for name, _, _ in TABLE), "|---|%s" % ("---|" * len(TABLE))]
+    for i, (case, _, _, _) in enumerate(cases):
+        lines.append("| %s | %s |" % (case, " | ".join("%.3f" % values[name][i] for name, _, _ in TABLE)))
+    return "\n".join(lines)
+
+
+def summary(cases, values, n_regular):
+    """Markdown: per candidate, the range of kappa / kappa_ref on the regular arrays and on the random cells."""
+    lines = ["| candidate | regular arrays | random cells | max \\|ln κ / κ_ref\\| |", "|---|---|---|---|"]
+    for name, description, _ in TABLE:
+        v = np.array(values[name])
         lines.append(
-            "| %s | %s | %.3f |"
-            % (label, " | ".join("%.3f" % r for r in ratios), np.abs(np.log(np.array(ratios))).max())
+            "| %s (%s) | %.3f – %.3f | %.3f – %.3f | %.3f |"
+            % (
+                name,
+                description,
+                v[:n_regular].min(),
+                v[:n_regular].max(),
+                v[n_regular:].min(),
+                v[n_regular:].max(),
+                np.abs(np.log(v)).max(),
+            )
         )
     return "\n".join(lines)
 
 
 def main():
-    paths = [periodic_random.RESULTS, periodic_random.SMALL_RESULTS]
-    print(table(regular_cases() + random_cases(paths)))
+    regular = regular_cases()
+    cases = regular + random_cases([periodic_random.RESULTS, periodic_random.SMALL_RESULTS])
+    values = ratios(cases)
+    print(summary(cases, values, len(regular)))
+    print()
+    print(table(cases, values))
     return 0
 
 

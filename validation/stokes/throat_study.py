@@ -135,13 +135,14 @@ def summary(rows):
 
 def figure(rows, path):
     """Per throat, k_PFV / k_FEM against the facet's open fraction A_f / A and against min(L_0, L_1) / L, every
-    case of the results, markers sized by the throat's share of the flux."""
+    case of the results, markers sized by the throat's share of its cell's flux and coloured by the cell's solid
+    fraction."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.4), sharey=True)
     for (name, shrink), row in cases(rows).items():
         d = throat_data(row)
         g, t = d["geometry"], d["model"]["throats"]
@@ -149,9 +150,10 @@ def figure(rows, path):
         ok = drop > MIN_DROP * drop.mean()
         ratio = t["conductance"][ok] / (d["q_fem"][ok] / d["drop_fem"][ok])
         size = 2000.0 * np.abs(d["q_fem"][ok]) / np.abs(d["q_fem"]).sum()
-        label = "%s (%d spheres)" % (name, row["n_spheres"])
-        axes[0].scatter((g["fluid_area"] / g["area"])[ok], ratio, s=size, alpha=0.35, label=label)
-        axes[1].scatter((np.minimum(g["l0"], g["l1"]) / g["length"])[ok], ratio, s=size, alpha=0.35)
+        colour = np.full(ok.sum(), d["packing"]["c"])
+        style = dict(s=size, alpha=0.35, c=colour, cmap="viridis", vmin=0.4, vmax=0.62)
+        points = axes[0].scatter((g["fluid_area"] / g["area"])[ok], ratio, **style)
+        axes[1].scatter((np.minimum(g["l0"], g["l1"]) / g["length"])[ok], ratio, **style)
     for ax, xlabel in zip(
         axes, ("A_f / A (open fraction of the facet)", "min(L_0, L_1) / L (< 0: power centre beyond")
     ):
@@ -161,9 +163,9 @@ def figure(rows, path):
         ax.grid(True, which="both", alpha=0.3)
     axes[1].set_xlim(-1.5, 0.55)
     axes[0].set_ylabel("k_PFV / k_FEM  (k_FEM = q_FEM / dp_FEM)")
-    axes[0].legend(fontsize=7, markerscale=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.colorbar(points, ax=axes, label="solid fraction c of the cell", fraction=0.03)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
 
 
 def main():

@@ -62,15 +62,6 @@ def orifice(t, g, gamma=3.0):
     return 1.0 / (g["length"] / (0.5 * g["fluid_area"] * g["hydraulic_radius"] ** 2) + gamma / a3)
 
 
-CANDIDATES = {
-    "thesis": thesis,
-    "constriction": constriction,
-    "facet_radius": facet_radius,
-    "entrance": entrance,
-    "orifice": orifice,
-}
-
-
 def clamped(k, low=1e-4, high=100.0):
     """The engine's clamp: k within [low, high] times the median (of the finite ones: a cospherical array has
     many flat pores, L = 0)."""

@@ -74,7 +74,7 @@ TABLE = [
     ("thesis", "the thesis' A_f R_h^2 / (2 L)", thesis),
     ("r_c", "Poiseuille through the constriction", constriction),
     ("A_f/P", "the thesis' form with the facet's own hydraulic radius", facet_radius),
-    ("Dagan", "entrance, beta = 3 pi / 8 (Dagan's)", entrance),
+    ("Dagan", "entrance, beta = 3 pi / 8", entrance),
     ("β = 1", "entrance, beta = 1", lambda t, g: entrance(t, g, beta=1.0)),
     ("γ = 2", "orifice, gamma = 2", lambda t, g: orifice(t, g, gamma=2.0)),
     ("(1 − φ)", "thesis x (1 - A_f / A)", lambda t, g: thesis(t, g) * (1.0 - g["fluid_area"] / g["area"])),

@@ -120,7 +120,7 @@ def random_cases(paths):
     """(name, PFV run, geometry, kappa_FEM on the finest mesh) of the stored random packings."""
     rows = [r for path in paths for r in periodic_random.load(path)]
     cases = []
-    for (name, shrink), row in throat_study.cases(rows).items():
+    for (name, shrink), row in periodic_random.finest(rows).items():
         d = throat_study.throat_data(row)
         label = name + ("@%g" % shrink if shrink else "")
         cases.append((label, d["model"], d["geometry"], row["kappa"]))

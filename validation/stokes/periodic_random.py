@@ -12,7 +12,6 @@ Packings with contacts (gap 0) are solved at the shrinks of doc/validation.md se
 touching; packings with a gap at every pair are solved as they are. Rows already in --out are not recomputed.
 """
 import argparse
-import json
 import os
 import resource
 import sys
@@ -20,7 +19,7 @@ import time
 
 import numpy as np
 
-from . import facet_flux, periodic_mesh, periodic_packings, periodic_solve, pfv_periodic
+from . import facet_flux, periodic_mesh, periodic_packings, periodic_run, periodic_solve, pfv_periodic
 from .mesh import tangled_cells
 from .packings import shrunk
 from .report import MIN_SHRINK_ORDER, check_stored, richardson
@@ -177,16 +176,11 @@ def run_cases(names, levels, out, solver="auto", log=print):
 
 
 def load(path):
-    if not os.path.exists(path):
-        return []
-    with open(path) as f:
-        return json.load(f)
+    return periodic_run.load(path)
 
 
 def save(rows, path):
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    with open(path, "w") as f:
-        json.dump(rows, f)
+    periodic_run.save(rows, path, indent=None)  # the throat arrays: one line each
 
 
 def finest(rows):

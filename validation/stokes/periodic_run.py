@@ -168,10 +168,10 @@ def load(path):
         return json.load(f)
 
 
-def save(rows, path):
+def save(rows, path, indent=1):
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w") as f:
-        json.dump(rows, f, indent=1)
+        json.dump(rows, f, indent=indent)
 
 
 def series(rows):

@@ -57,16 +57,6 @@ def features(model, packing):
     }
 
 
-def cases(rows):
-    """{(packing, shrink): the finest row}."""
-    out = {}
-    for r in rows:
-        key = (r["packing"], r["shrink"])
-        if key not in out or r["surface"] < out[key]["surface"]:
-            out[key] = r
-    return out
-
-
 def throat_data(row):
     """The model, geometry and reference numbers of every throat of one results row."""
     p = periodic_packings.load(row["packing"])
@@ -98,7 +88,7 @@ def binned(values, ratio, weight, edges):
 
 def summary(rows):
     lines = []
-    for (name, shrink), row in cases(rows).items():
+    for (name, shrink), row in periodic_random.finest(rows).items():
         d = throat_data(row)
         g, t = d["geometry"], d["model"]["throats"]
         k_fem = d["q_fem"] / d["drop_fem"]
@@ -143,7 +133,7 @@ def figure(rows, path):
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.4), sharey=True)
-    for (name, shrink), row in cases(rows).items():
+    for (name, shrink), row in periodic_random.finest(rows).items():
         d = throat_data(row)
         g, t = d["geometry"], d["model"]["throats"]
         drop = np.abs(d["drop_fem"])

@@ -40,8 +40,6 @@ def run(packing, direction=(1.0, 0.0, 0.0)):
     t["radii"] = radii[np.asarray(flow.image_spheres())[t["vertices"]]]
     t["power_centre_0"] = centres[t["cells"][:, 0]]
     t["power_centre_1"] = centres[t["cells"][:, 1]] + t["translation"]
-    t["cell_vertices"] = images[np.asarray(flow.cell_vertices())][t["cells"][:, 0]]  # side 0's tetrahedron
-    t["cell_vertices_1"] = images[np.asarray(flow.cell_vertices())][t["cells"][:, 1]] + t["translation"][:, None, :]
     volumes = np.asarray(flow.fluid_volumes())
     t["fluid_volume_0"], t["fluid_volume_1"] = volumes[t["cells"][:, 0]], volumes[t["cells"][:, 1]]
     return {

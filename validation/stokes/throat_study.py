@@ -53,7 +53,6 @@ def features(model, packing):
         "volume_ratio": np.maximum(t["fluid_volume_0"], t["fluid_volume_1"])
         / np.maximum(np.minimum(t["fluid_volume_0"], t["fluid_volume_1"]), 1e-300),
         "min_gap": np.min(gaps, axis=0),
-        "mean_radius": r.mean(1),
     }
 
 
